@@ -1,0 +1,217 @@
+//! # sss-bssrdf: BSSRDF models for subsurface scattering
+//!
+//! Use this crate when you need the *physics* of translucent materials (skin, marble, milk,
+//! wax) and nothing else: a validated [`Medium`], exact [`fresnel`] terms, four diffusion
+//! models behind one [`Bssrdf`] trait, importance sampling of their radial profiles, and a
+//! Monte Carlo photon random walk ([`monte_carlo`]) that is the ground truth the models are
+//! measured against. It depends on no renderer; everything is `f64`, and every constructor
+//! validates its input and returns a [`BssrdfError`] instead of panicking.
+//!
+//! ```
+//! use sss_bssrdf::{make_model, Bssrdf, Medium, ModelKind};
+//!
+//! let skin = Medium::preset("skin1")?;                       // Jensen et al. 2001, Table 2
+//! let model = make_model(ModelKind::BetterDipole, &skin);
+//! let rd_red = model.rd(0, 0.5);                             // Rd(0.5 mm), 1/mm²
+//! let total = model.total_diffuse_reflectance(0);            // ∫ 2πr Rd(r) dr
+//! let r = model.sample_sr(0, 0.3);                           // r ∝ 2πr Rd(r)
+//! let pdf = model.pdf_sr(0, r);                              // its density per mm
+//! let cull = model.radius_for_energy(0, 0.99);               // radius holding 99 %
+//! assert!(rd_red > 0.0 && total < 1.0 && pdf > 0.0 && cull > r.min(cull) - 1.0);
+//! # Ok::<(), sss_bssrdf::BssrdfError>(())
+//! ```
+//!
+//! ## Conventions
+//! - Lengths in mm, coefficients in 1/mm, RGB channels indexed 0, 1, 2.
+//! - `rd(ch, r)` is the radial profile R_d(r) in 1/mm² per unit power *entering* the medium
+//!   (the entry Fresnel factor is not included, as in Jensen et al. 2001), at normal incidence;
+//!   ∫₀^∞ 2πr R_d(r) dr is the total diffuse reflectance.
+//! - The full BSSRDF of the separable models is, as in pbrt (3rd ed. §11.4 and §15.4),
+//!   S = F_t(η, ω_o) · R_d(‖x_o − x_i‖) · F_t(η, ω_i) / (c π), c = 1 − 2 C₁(η).
+//! - Fresnel `eta` arguments are n_t / n_i; see [`fresnel`].
+//!
+//! ## Papers implemented
+//! - Jensen, Marschner, Levoy, Hanrahan. *A Practical Model for Subsurface Light Transport.*
+//!   SIGGRAPH 2001 — the standard dipole ([`StandardDipole`]) and the measured presets.
+//! - d'Eon. *A Better Dipole.* 2012 — [`BetterDipole`].
+//! - Frisvad, Hachisuka, Kjeldsen. *Directional Dipole Model for Subsurface Scattering.*
+//!   ACM TOG 34(1), 2014 — [`DirectionalDipole`].
+//! - Habel, Christensen, Jarosz. *Photon Beam Diffusion: A Hybrid Monte Carlo Method for
+//!   Subsurface Scattering.* EGSR 2013, tabulated as in Pharr, Jakob, Humphreys, *Physically
+//!   Based Rendering* 3rd ed. §11.4.2, §15.4-15.5 — [`PhotonBeamDiffusion`].
+//! - Wang, Jacques, Zheng. *MCML — Monte Carlo modeling of light transport in multi-layered
+//!   tissues.* 1995 — the photon random walk in [`monte_carlo`].
+
+// `!(x > 0.0)` is how this crate rejects NaN along with non-positive values; clippy's
+// suggestion `x <= 0.0` would let NaN through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod better_dipole;
+pub mod catmull_rom;
+pub mod directional_dipole;
+mod error;
+pub mod fresnel;
+mod inversion;
+mod medium;
+pub mod monte_carlo;
+pub mod photon_beam_diffusion;
+pub mod presets;
+pub mod quadrature;
+pub mod radial;
+pub mod standard_dipole;
+
+use std::fmt;
+use std::str::FromStr;
+
+pub use better_dipole::BetterDipole;
+pub use directional_dipole::DirectionalDipole;
+pub use error::BssrdfError;
+pub use glam::DVec3;
+pub use inversion::from_reflectance;
+pub use medium::Medium;
+pub use photon_beam_diffusion::PhotonBeamDiffusion;
+pub use standard_dipole::StandardDipole;
+
+/// Three linear colour channels (red, green, blue).
+pub type Rgb = [f64; 3];
+
+/// A point on the boundary of a translucent object with its unit normal, pointing out of the
+/// medium.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// Position (mm, or scene units converted to mm by the caller).
+    pub p: DVec3,
+    /// Unit outward normal.
+    pub n: DVec3,
+}
+
+/// A BSSRDF model of one medium.
+///
+/// Every method takes a channel `ch` in 0..3 and returns finite, non-negative values for every
+/// valid [`Medium`] (including albedo 0 and 1, r = 0, grazing angles, η < 1 and η = 1).
+pub trait Bssrdf: Send + Sync {
+    /// Which model this is.
+    fn kind(&self) -> ModelKind;
+
+    /// The medium the model was built for.
+    fn medium(&self) -> &Medium;
+
+    /// Radial profile R_d(r) in 1/mm² (per unit power entering the medium, normal incidence).
+    fn rd(&self, ch: usize, r: f64) -> f64;
+
+    /// Total diffuse reflectance ∫₀^∞ 2πr R_d(r) dr of channel `ch` (closed form where one
+    /// exists, quadrature otherwise); in [0, 1].
+    fn total_diffuse_reflectance(&self, ch: usize) -> f64;
+
+    /// Samples a radius with density proportional to 2πr R_d(r), from a uniform `u` in [0, 1).
+    fn sample_sr(&self, ch: usize, u: f64) -> f64;
+
+    /// Density (per mm of radius) with which [`Bssrdf::sample_sr`] returns `r`; integrates
+    /// to 1 over [0, ∞). Divide by 2πr for the density per unit area of the plane.
+    fn pdf_sr(&self, ch: usize, r: f64) -> f64;
+
+    /// The radius holding `fraction` (in [0, 1)) of the channel's diffuse reflectance: beyond it
+    /// the profile may be culled.
+    fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64;
+
+    /// R_d(r) for the three channels.
+    fn rd_rgb(&self, r: f64) -> Rgb {
+        [self.rd(0, r), self.rd(1, r), self.rd(2, r)]
+    }
+
+    /// Spatial term S_p(x_i, x_o) = R_d(‖x_o − x_i‖) of the separable factorisation.
+    fn sp(&self, xi: &SurfacePoint, xo: &SurfacePoint) -> Rgb {
+        self.rd_rgb((xo.p - xi.p).length())
+    }
+
+    /// The full BSSRDF S(x_i, ω_i; x_o, ω_o) in 1/(mm² sr). `wi` points from x_i towards the
+    /// light, `wo` from x_o towards the viewer; both unit vectors. Directions below their
+    /// surface give 0.
+    ///
+    /// The default is the separable form of pbrt (3rd ed. Eq. 11.6-11.7):
+    /// S = F_t(η, cos θ_o) R_d(r) F_t(η, cos θ_i) / (c π), c = 1 − 2 C₁(η). The directional
+    /// dipole overrides it with its full expression.
+    fn s(&self, xi: &SurfacePoint, wi: DVec3, xo: &SurfacePoint, wo: DVec3) -> Rgb {
+        separable_s(self.medium(), self.sp(xi, xo), xi.n.dot(wi), xo.n.dot(wo))
+    }
+}
+
+/// S = F_t(η, cos_o) · sp · F_t(η, cos_i) / (c π) for given cosines, shared by the separable
+/// models and by renderers that already hold R_d.
+pub fn separable_s(medium: &Medium, sp: Rgb, cos_i: f64, cos_o: f64) -> Rgb {
+    if !(cos_i > 0.0) || !(cos_o > 0.0) {
+        return [0.0; 3];
+    }
+    let eta = medium.eta();
+    let c = fresnel_normalization(eta);
+    let w = fresnel::ft_dielectric(cos_i, eta) * fresnel::ft_dielectric(cos_o, eta)
+        / (c * std::f64::consts::PI);
+    [sp[0] * w, sp[1] * w, sp[2] * w]
+}
+
+/// c = 1 − 2 C₁(η) = ∫ F_t(η, cos θ) cos θ dω / π: the normalisation that makes the
+/// directional factor F_t/(cπ) integrate to one over the hemisphere. Never 0 (at least the
+/// normal-incidence cone transmits for every finite η).
+pub fn fresnel_normalization(eta: f64) -> f64 {
+    (1.0 - 2.0 * fresnel::fresnel_moment1(eta)).max(f64::MIN_POSITIVE)
+}
+
+/// The four models, by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ModelKind {
+    /// Jensen et al. 2001.
+    StandardDipole,
+    /// d'Eon 2012.
+    BetterDipole,
+    /// Frisvad et al. 2014.
+    DirectionalDipole,
+    /// Habel et al. 2013, tabulated as in pbrt.
+    PhotonBeamDiffusion,
+}
+
+impl ModelKind {
+    /// Every model, in the order reports list them.
+    pub const ALL: [ModelKind; 4] = [
+        ModelKind::StandardDipole,
+        ModelKind::BetterDipole,
+        ModelKind::DirectionalDipole,
+        ModelKind::PhotonBeamDiffusion,
+    ];
+
+    /// The command-line name (`standard-dipole`, `better-dipole`, `directional-dipole`, `pbd`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::StandardDipole => "standard-dipole",
+            ModelKind::BetterDipole => "better-dipole",
+            ModelKind::DirectionalDipole => "directional-dipole",
+            ModelKind::PhotonBeamDiffusion => "pbd",
+        }
+    }
+}
+
+impl fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ModelKind {
+    type Err = BssrdfError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        ModelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| BssrdfError::UnknownModel(s.to_string()))
+    }
+}
+
+/// Builds the model `kind` for `medium`. Photon beam diffusion shares one table per (g, η)
+/// across all media (built on first use, in parallel).
+pub fn make_model(kind: ModelKind, medium: &Medium) -> Box<dyn Bssrdf> {
+    match kind {
+        ModelKind::StandardDipole => Box::new(StandardDipole::new(medium.clone())),
+        ModelKind::BetterDipole => Box::new(BetterDipole::new(medium.clone())),
+        ModelKind::DirectionalDipole => Box::new(DirectionalDipole::new(medium.clone())),
+        ModelKind::PhotonBeamDiffusion => Box::new(PhotonBeamDiffusion::new(medium.clone())),
+    }
+}

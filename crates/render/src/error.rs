@@ -1,0 +1,73 @@
+//! The crate's error type.
+
+use crate::plot::PlotError;
+use sss_bssrdf::BssrdfError;
+use std::fmt;
+
+/// Everything the command-line tool and the library around it report.
+///
+/// Messages are single lines meant for a person (`error: ` is prepended by the binary).
+#[derive(Debug)]
+pub enum Error {
+    /// Invalid user input that was not caught by argument parsing (exit code 2).
+    Input(String),
+    /// An invalid medium or model parameter (exit code 2).
+    Bssrdf(BssrdfError),
+    /// A plot could not be drawn or written (exit code 1).
+    Plot(PlotError),
+    /// An I/O failure, with what was being done (exit code 1).
+    Io {
+        /// What was being read or written.
+        what: String,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A model produced a value that is not a finite number (exit code 1): a bug in the model,
+    /// reported instead of printed.
+    NonFinite(String),
+}
+
+impl Error {
+    /// The process exit code for this error: 2 for bad input, 1 for failures while running.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::Input(_) | Error::Bssrdf(_) => 2,
+            Error::Plot(PlotError::UnsupportedFormat(_)) => 2,
+            Error::Plot(_) | Error::Io { .. } | Error::NonFinite(_) => 1,
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Input(msg) | Error::NonFinite(msg) => f.write_str(msg),
+            Error::Bssrdf(e) => write!(f, "{e}"),
+            Error::Plot(e) => write!(f, "{e}"),
+            Error::Io { what, source } => write!(f, "{what}: {source}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Bssrdf(e) => Some(e),
+            Error::Plot(e) => Some(e),
+            Error::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}
+
+impl From<BssrdfError> for Error {
+    fn from(e: BssrdfError) -> Self {
+        Error::Bssrdf(e)
+    }
+}
+
+impl From<PlotError> for Error {
+    fn from(e: PlotError) -> Self {
+        Error::Plot(e)
+    }
+}

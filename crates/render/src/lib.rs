@@ -1,0 +1,35 @@
+//! # sss-render: the subsurface-scattering toolkit's front end
+//!
+//! Today this crate holds the `sss` command-line tool and the pieces around it that other
+//! tools reuse: PNG/SVG line plots ([`plot`]), radial-profile tables of any model or of the
+//! Monte Carlo reference ([`profile`]), the measured-material table ([`presets_table`]) and
+//! progress bars ([`progress`]). Scenes, ray casting and the subsurface integrators will live
+//! here later.
+//!
+//! ```
+//! use sss_render::profile::{compute, MediumSpec, ProfileModel, ProfileRequest};
+//!
+//! // Rd(r) of the directional dipole for skim milk at 8 radii up to 10 mm.
+//! let req = ProfileRequest {
+//!     steps: 8,
+//!     ..ProfileRequest::new(ProfileModel::DirectionalDipole, MediumSpec::Preset("skimmilk".into()), 10.0)
+//! };
+//! let table = compute(&req, &|_| {})?;
+//! assert_eq!(table.rows.len(), 8);
+//! assert!(table.rows.iter().all(|row| row.rd.iter().all(|v| v.is_finite() && *v >= 0.0)));
+//! # Ok::<(), sss_render::Error>(())
+//! ```
+//!
+//! ## Papers
+//! None of its own yet: it composes the models of `sss-bssrdf` (Jensen et al. 2001, d'Eon
+//! 2012, Frisvad et al. 2014, Habel et al. 2013) and its Monte Carlo reference (MCML, Wang et
+//! al. 1995).
+
+pub mod cli;
+mod error;
+pub mod plot;
+pub mod presets_table;
+pub mod profile;
+pub mod progress;
+
+pub use error::Error;

@@ -1,0 +1,463 @@
+//! Radial profiles R_d(r) of a model or of the Monte Carlo reference, as a table: the library
+//! behind `sss profile`.
+//!
+//! [`ProfileRequest`] says what to compute, [`compute`] evaluates it into a [`ProfileTable`],
+//! which writes itself as CSV ([`ProfileTable::write_csv`]) and draws itself
+//! ([`ProfileTable::plot`]).
+//!
+//! ```
+//! use sss_render::profile::{compute, MediumSpec, ProfileModel, ProfileRequest};
+//! let req = ProfileRequest {
+//!     steps: 4,
+//!     ..ProfileRequest::new(ProfileModel::Pbd, MediumSpec::Preset("skin1".into()), 5.0)
+//! };
+//! let table = compute(&req, &|_| {})?;
+//! let mut csv = Vec::new();
+//! table.write_csv(&mut csv).unwrap();
+//! assert!(String::from_utf8(csv).unwrap().starts_with("# total_diffuse_reflectance="));
+//! # Ok::<(), sss_render::Error>(())
+//! ```
+
+use crate::Error;
+use crate::plot::{CHANNEL_COLORS, ErrorStyle, Series, line_plot};
+use sss_bssrdf::monte_carlo::{self, McConfig};
+use sss_bssrdf::{Medium, ModelKind, Rgb, make_model, presets};
+use std::io::Write;
+use std::path::Path;
+
+/// Largest accepted `steps` (rows) for an analytic model, to keep the output bounded.
+pub const MAX_STEPS: usize = 10_000_000;
+
+/// What produces the profile: one of the models, or the Monte Carlo reference.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum ProfileModel {
+    /// Jensen et al. 2001.
+    StandardDipole,
+    /// d'Eon 2012.
+    BetterDipole,
+    /// Frisvad et al. 2014 (its normal-incidence radial profile).
+    DirectionalDipole,
+    /// Photon beam diffusion (Habel et al. 2013), tabulated as in pbrt.
+    Pbd,
+    /// The Monte Carlo photon random walk of `sss_bssrdf::monte_carlo`.
+    MonteCarlo,
+}
+
+impl ProfileModel {
+    /// The analytic model, or `None` for the Monte Carlo reference.
+    pub fn kind(self) -> Option<ModelKind> {
+        match self {
+            ProfileModel::StandardDipole => Some(ModelKind::StandardDipole),
+            ProfileModel::BetterDipole => Some(ModelKind::BetterDipole),
+            ProfileModel::DirectionalDipole => Some(ModelKind::DirectionalDipole),
+            ProfileModel::Pbd => Some(ModelKind::PhotonBeamDiffusion),
+            ProfileModel::MonteCarlo => None,
+        }
+    }
+
+    /// The command-line name (the same as [`ModelKind::name`] for the models).
+    pub fn name(self) -> &'static str {
+        match self.kind() {
+            Some(k) => k.name(),
+            None => "monte-carlo",
+        }
+    }
+}
+
+/// Where the medium comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MediumSpec {
+    /// A measured material of Jensen et al. 2001 by name (g = 0, σ_s = σ'_s).
+    Preset(String),
+    /// Explicit coefficients (1/mm) and anisotropy.
+    Coefficients {
+        /// Absorption σ_a per channel.
+        sigma_a: Rgb,
+        /// Scattering σ_s per channel.
+        sigma_s: Rgb,
+        /// Henyey-Greenstein anisotropy.
+        g: f64,
+    },
+}
+
+/// Everything `sss profile` needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProfileRequest {
+    /// The model (or Monte Carlo).
+    pub model: ProfileModel,
+    /// The medium.
+    pub medium: MediumSpec,
+    /// Relative index of refraction; `None` keeps the default 1.3 (the presets' value).
+    pub eta: Option<f64>,
+    /// Largest radius (mm).
+    pub r_max: f64,
+    /// Number of rows: radii for a model, radial bins for Monte Carlo.
+    pub steps: usize,
+    /// Log-spaced radii from r_max·1e-4 to r_max instead of linear r_max/N..r_max (models only).
+    pub log: bool,
+    /// Monte Carlo photons per channel.
+    pub photons: u64,
+    /// Monte Carlo seed.
+    pub seed: u64,
+}
+
+impl ProfileRequest {
+    /// A request with the command-line defaults: 100 linear steps, 10⁶ photons, seed 1.
+    pub fn new(model: ProfileModel, medium: MediumSpec, r_max: f64) -> Self {
+        ProfileRequest {
+            model,
+            medium,
+            eta: None,
+            r_max,
+            steps: 100,
+            log: false,
+            photons: 1_000_000,
+            seed: 1,
+        }
+    }
+}
+
+/// One row of a profile table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProfileRow {
+    /// Radius (mm); the bin centre for Monte Carlo.
+    pub r: f64,
+    /// R_d per channel (1/mm²); the bin's area average for Monte Carlo.
+    pub rd: Rgb,
+    /// Standard error of `rd` (Monte Carlo only).
+    pub se: Option<Rgb>,
+}
+
+/// A computed profile.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProfileTable {
+    /// What produced it.
+    pub model: ProfileModel,
+    /// A short description of the medium (preset name or coefficients).
+    pub medium_label: String,
+    /// Total diffuse reflectance per channel (the model's, or Monte Carlo's estimate).
+    pub total: Rgb,
+    /// The rows, by increasing radius.
+    pub rows: Vec<ProfileRow>,
+}
+
+/// Builds the medium of `spec`, with `eta` if given (default [`presets::PRESET_ETA`]).
+pub fn build_medium(spec: &MediumSpec, eta: Option<f64>) -> Result<Medium, Error> {
+    let eta = eta.unwrap_or(presets::PRESET_ETA);
+    let medium = match spec {
+        MediumSpec::Preset(name) => Medium::preset(name)?.with_eta(eta)?,
+        MediumSpec::Coefficients {
+            sigma_a,
+            sigma_s,
+            g,
+        } => Medium::new(*sigma_a, *sigma_s, *g, eta)?,
+    };
+    Ok(medium)
+}
+
+/// The radii of a model profile: `steps` values r_max/N, 2r_max/N, …, r_max, or with `log`
+/// log-spaced from r_max·1e-4 to r_max (a single step gives r_max).
+pub fn radii(r_max: f64, steps: usize, log: bool) -> Vec<f64> {
+    (0..steps)
+        .map(|i| {
+            if log {
+                if steps == 1 {
+                    r_max
+                } else {
+                    r_max * 10f64.powf(-4.0 + 4.0 * i as f64 / (steps - 1) as f64)
+                }
+            } else if i + 1 == steps {
+                r_max
+            } else {
+                r_max * (i + 1) as f64 / steps as f64
+            }
+        })
+        .collect()
+}
+
+fn check_request(req: &ProfileRequest) -> Result<(), Error> {
+    if !(req.r_max.is_finite() && req.r_max > 0.0) {
+        return Err(Error::Input(format!(
+            "--r-max {} must be a finite number of mm > 0",
+            req.r_max
+        )));
+    }
+    if req.steps == 0 {
+        return Err(Error::Input("--steps must be at least 1".into()));
+    }
+    match req.model {
+        ProfileModel::MonteCarlo => {
+            if req.log {
+                return Err(Error::Input(
+                    "--log is not available for --model monte-carlo (its bins are linear over [0, r_max])"
+                        .into(),
+                ));
+            }
+            if req.steps > monte_carlo::MAX_BINS {
+                return Err(Error::Input(format!(
+                    "--steps {} exceeds the Monte Carlo limit of {} bins",
+                    req.steps,
+                    monte_carlo::MAX_BINS
+                )));
+            }
+            if req.photons == 0 {
+                return Err(Error::Input("--photons must be at least 1".into()));
+            }
+        }
+        _ => {
+            if req.steps > MAX_STEPS {
+                return Err(Error::Input(format!(
+                    "--steps {} exceeds the limit of {MAX_STEPS}",
+                    req.steps
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn medium_label(spec: &MediumSpec, medium: &Medium) -> String {
+    match spec {
+        MediumSpec::Preset(name) => format!("{name}, eta {}", medium.eta()),
+        MediumSpec::Coefficients {
+            sigma_a,
+            sigma_s,
+            g,
+        } => format!(
+            "sigma_a {:?}, sigma_s {:?}, g {g}, eta {}",
+            sigma_a,
+            sigma_s,
+            medium.eta()
+        ),
+    }
+}
+
+fn finite(what: &str, v: f64) -> Result<f64, Error> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Error::NonFinite(format!(
+            "{what} is {v}, not a finite number (a bug in the model; nothing was printed)"
+        )))
+    }
+}
+
+/// Evaluates `req`. `progress` receives the cumulative number of Monte Carlo photons
+/// finished (over the three channels, so it ends at 3 × photons); it is not called for the
+/// analytic models.
+pub fn compute(
+    req: &ProfileRequest,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<ProfileTable, Error> {
+    check_request(req)?;
+    let medium = build_medium(&req.medium, req.eta)?;
+    let medium_label = medium_label(&req.medium, &medium);
+    let (total, rows) = match req.model.kind() {
+        Some(kind) => {
+            let model = make_model(kind, &medium);
+            let mut total = [0.0; 3];
+            for (ch, t) in total.iter_mut().enumerate() {
+                *t = finite(
+                    &format!("{kind} total diffuse reflectance [{ch}]"),
+                    model.total_diffuse_reflectance(ch),
+                )?;
+            }
+            let rows = radii(req.r_max, req.steps, req.log)
+                .into_iter()
+                .map(|r| {
+                    let rd = model.rd_rgb(r);
+                    for (ch, v) in rd.iter().enumerate() {
+                        finite(&format!("{kind} Rd[{ch}]({r} mm)"), *v)?;
+                    }
+                    Ok(ProfileRow { r, rd, se: None })
+                })
+                .collect::<Result<Vec<_>, Error>>()?;
+            (total, rows)
+        }
+        None => {
+            let cfg = McConfig {
+                photons: req.photons,
+                seed: req.seed,
+                r_max: req.r_max,
+                bins: req.steps,
+                channels: [true; 3],
+            };
+            let mc = monte_carlo::simulate_with_progress(&medium, &cfg, progress)?;
+            let rows = mc
+                .bin_centers()
+                .into_iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    let rd = [mc.rd[0][i], mc.rd[1][i], mc.rd[2][i]];
+                    let se = [mc.se[0][i], mc.se[1][i], mc.se[2][i]];
+                    for ch in 0..3 {
+                        finite("Monte Carlo Rd", rd[ch])?;
+                        finite("Monte Carlo standard error", se[ch])?;
+                    }
+                    Ok(ProfileRow {
+                        r,
+                        rd,
+                        se: Some(se),
+                    })
+                })
+                .collect::<Result<Vec<_>, Error>>()?;
+            for t in mc.total {
+                finite("Monte Carlo total", t)?;
+            }
+            (mc.total, rows)
+        }
+    };
+    Ok(ProfileTable {
+        model: req.model,
+        medium_label,
+        total,
+        rows,
+    })
+}
+
+impl ProfileTable {
+    /// True when the rows carry standard errors (Monte Carlo).
+    pub fn has_se(&self) -> bool {
+        self.rows.iter().any(|r| r.se.is_some())
+    }
+
+    /// Writes the table as CSV: one comment line `# total_diffuse_reflectance=R,G,B`, the
+    /// header `r_mm,rd_r,rd_g,rd_b` (plus `,se_r,se_g,se_b` for Monte Carlo) and one row per
+    /// radius. Numbers are in shortest round-trip scientific notation (`1.25e-3`).
+    pub fn write_csv(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let [t0, t1, t2] = self.total;
+        writeln!(w, "# total_diffuse_reflectance={t0:e},{t1:e},{t2:e}")?;
+        let se = self.has_se();
+        if se {
+            writeln!(w, "r_mm,rd_r,rd_g,rd_b,se_r,se_g,se_b")?;
+        } else {
+            writeln!(w, "r_mm,rd_r,rd_g,rd_b")?;
+        }
+        for row in &self.rows {
+            let [a, b, c] = row.rd;
+            write!(w, "{:e},{a:e},{b:e},{c:e}", row.r)?;
+            if se {
+                let [x, y, z] = row.se.unwrap_or([0.0; 3]);
+                write!(w, ",{x:e},{y:e},{z:e}")?;
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    }
+
+    /// Draws the three channels on a log y axis (log x too when `log_x`), Monte Carlo with
+    /// its standard errors as a band, to `path` (`.png` or `.svg`).
+    pub fn plot(&self, path: &Path, log_x: bool) -> Result<(), Error> {
+        let names = ["red", "green", "blue"];
+        let series: Vec<Series> = (0..3)
+            .map(|ch| {
+                let points = self.rows.iter().map(|r| (r.r, r.rd[ch])).collect();
+                let s = Series::line(names[ch], points).with_color(CHANNEL_COLORS[ch]);
+                if self.has_se() {
+                    let err = self
+                        .rows
+                        .iter()
+                        .map(|r| r.se.map_or(0.0, |se| se[ch]))
+                        .collect();
+                    s.with_errors(err, ErrorStyle::Band)
+                } else {
+                    s
+                }
+            })
+            .collect();
+        let title = format!("Rd(r), {}: {}", self.model.name(), self.medium_label);
+        line_plot(path, &title, "r (mm)", "Rd (1/mm²)", &series, log_x, true)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radii_linear_and_log() {
+        let r = radii(2.0, 4, false);
+        assert_eq!(r, vec![0.5, 1.0, 1.5, 2.0]);
+        let r = radii(10.0, 5, true);
+        assert!((r[0] - 1e-3).abs() < 1e-15 && (r[4] - 10.0).abs() < 1e-12);
+        assert!((r[2] - 0.1).abs() < 1e-14);
+        assert_eq!(radii(3.0, 1, true), vec![3.0]);
+        assert_eq!(radii(3.0, 1, false), vec![3.0]);
+    }
+
+    #[test]
+    fn names_match_the_models() {
+        use clap::ValueEnum;
+        for m in ProfileModel::value_variants() {
+            let pv = m.to_possible_value().unwrap();
+            assert_eq!(pv.get_name(), m.name());
+        }
+        for k in ModelKind::ALL {
+            assert!(
+                ProfileModel::value_variants()
+                    .iter()
+                    .any(|m| m.kind() == Some(k))
+            );
+        }
+    }
+
+    #[test]
+    fn bad_requests_are_rejected() {
+        let base = ProfileRequest::new(
+            ProfileModel::StandardDipole,
+            MediumSpec::Preset("skin1".into()),
+            1.0,
+        );
+        for bad in [
+            ProfileRequest {
+                r_max: 0.0,
+                ..base.clone()
+            },
+            ProfileRequest {
+                r_max: f64::NAN,
+                ..base.clone()
+            },
+            ProfileRequest {
+                steps: 0,
+                ..base.clone()
+            },
+            ProfileRequest {
+                medium: MediumSpec::Preset("nope".into()),
+                ..base.clone()
+            },
+            ProfileRequest {
+                eta: Some(-1.0),
+                ..base.clone()
+            },
+            ProfileRequest {
+                model: ProfileModel::MonteCarlo,
+                log: true,
+                ..base.clone()
+            },
+        ] {
+            assert!(compute(&bad, &|_| {}).is_err(), "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn csv_layout() {
+        let t = ProfileTable {
+            model: ProfileModel::MonteCarlo,
+            medium_label: "x".into(),
+            total: [0.5, 0.25, 0.125],
+            rows: vec![ProfileRow {
+                r: 0.5,
+                rd: [1.0, 2.0, 3.0],
+                se: Some([0.1, 0.2, 0.3]),
+            }],
+        };
+        let mut out = Vec::new();
+        t.write_csv(&mut out).unwrap();
+        let s = String::from_utf8(out).unwrap();
+        assert_eq!(
+            s,
+            "# total_diffuse_reflectance=5e-1,2.5e-1,1.25e-1\nr_mm,rd_r,rd_g,rd_b,se_r,se_g,se_b\n5e-1,1e0,2e0,3e0,1e-1,2e-1,3e-1\n"
+        );
+    }
+}

@@ -1,0 +1,517 @@
+//! End-to-end tests of the `sss` binary: output format, agreement with the library, error
+//! handling and plots.
+
+use sss_bssrdf::{Medium, ModelKind, make_model, presets::PRESETS};
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn sss(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sss"))
+        .args(args)
+        .output()
+        .expect("run sss")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).expect("utf-8 stdout")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).expect("utf-8 stderr")
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = sss(args);
+    assert!(o.status.success(), "sss {args:?} failed: {}", stderr(&o));
+    stdout(&o)
+}
+
+/// A parsed profile CSV: the comment line's totals, the header and the numeric rows.
+struct Csv {
+    total: [f64; 3],
+    header: String,
+    rows: Vec<Vec<f64>>,
+}
+
+fn parse_csv(text: &str) -> Csv {
+    let mut lines = text.lines();
+    let comment = lines.next().expect("comment line");
+    let totals = comment
+        .strip_prefix("# total_diffuse_reflectance=")
+        .unwrap_or_else(|| panic!("bad comment line {comment:?}"));
+    let t: Vec<f64> = totals.split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(t.len(), 3);
+    let header = lines.next().expect("header").to_string();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            assert!(!l.starts_with('#'), "exactly one comment line");
+            l.split(',')
+                .map(|v| {
+                    let x: f64 = v.parse().unwrap_or_else(|_| panic!("bad number {v:?}"));
+                    assert!(x.is_finite());
+                    x
+                })
+                .collect()
+        })
+        .collect();
+    Csv {
+        total: [t[0], t[1], t[2]],
+        header,
+        rows,
+    }
+}
+
+fn tmp_dir(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{name}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn rel_close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * a.abs().max(b.abs()) || (a - b).abs() < 1e-300
+}
+
+#[test]
+fn profile_output_has_one_comment_line_and_the_header() {
+    for model in ModelKind::ALL {
+        let out = ok(&[
+            "profile",
+            "--model",
+            model.name(),
+            "--preset",
+            "skin1",
+            "--r-max",
+            "4",
+            "--steps",
+            "7",
+        ]);
+        let lines: Vec<&str> = out.lines().collect();
+        assert_eq!(lines.len(), 9, "{model}: {out}");
+        assert!(lines[0].starts_with("# total_diffuse_reflectance="));
+        assert_eq!(lines.iter().filter(|l| l.starts_with('#')).count(), 1);
+        assert_eq!(lines[1], "r_mm,rd_r,rd_g,rd_b");
+        let csv = parse_csv(&out);
+        assert!(csv.rows.iter().all(|r| r.len() == 4));
+        // Linear radii r_max/N .. r_max.
+        assert!(rel_close(csv.rows[0][0], 4.0 / 7.0, 1e-15));
+        assert_eq!(csv.rows[6][0], 4.0);
+    }
+}
+
+#[test]
+fn profile_values_equal_the_library() {
+    let medium = Medium::preset("marble").unwrap().with_eta(1.4).unwrap();
+    for model in ModelKind::ALL {
+        let lib = make_model(model, &medium);
+        for log in [false, true] {
+            let mut args = vec![
+                "profile",
+                "--model",
+                model.name(),
+                "--preset",
+                "marble",
+                "--eta",
+                "1.4",
+                "--r-max",
+                "30",
+                "--steps",
+                "25",
+            ];
+            if log {
+                args.push("--log");
+            }
+            let csv = parse_csv(&ok(&args));
+            assert_eq!(csv.rows.len(), 25);
+            for ch in 0..3 {
+                assert!(
+                    rel_close(csv.total[ch], lib.total_diffuse_reflectance(ch), 1e-9),
+                    "{model} total {ch}"
+                );
+            }
+            for row in &csv.rows {
+                for ch in 0..3 {
+                    let want = lib.rd(ch, row[0]);
+                    assert!(
+                        rel_close(row[1 + ch], want, 1e-9),
+                        "{model} r {} ch {ch}: {} vs {want}",
+                        row[0],
+                        row[1 + ch]
+                    );
+                }
+            }
+            if log {
+                assert!(rel_close(csv.rows[0][0], 30.0e-4, 1e-12));
+                assert!(rel_close(csv.rows[24][0], 30.0, 1e-12));
+            }
+        }
+    }
+}
+
+#[test]
+fn profile_from_coefficients_equals_the_library() {
+    let medium = Medium::new([0.05, 0.1, 0.3], [2.0, 1.5, 1.0], 0.3, 1.2).unwrap();
+    for model in [ModelKind::StandardDipole, ModelKind::PhotonBeamDiffusion] {
+        let lib = make_model(model, &medium);
+        let csv = parse_csv(&ok(&[
+            "profile",
+            "--model",
+            model.name(),
+            "--sigma-a",
+            "0.05,0.1,0.3",
+            "--sigma-s",
+            "2,1.5,1",
+            "--g",
+            "0.3",
+            "--eta",
+            "1.2",
+            "--r-max",
+            "5",
+            "--steps",
+            "10",
+        ]));
+        for row in &csv.rows {
+            for ch in 0..3 {
+                assert!(rel_close(row[1 + ch], lib.rd(ch, row[0]), 1e-9));
+            }
+        }
+    }
+}
+
+#[test]
+fn standard_dipole_profile_integrates_to_its_total() {
+    // Trapezoid rule over 2πr Rd(r) from r = 0 (where the integrand is 0) to 60 mm, far past
+    // where skin1's profile has decayed (σ_tr ≥ 0.27/mm).
+    let csv = parse_csv(&ok(&[
+        "profile",
+        "--model",
+        "standard-dipole",
+        "--preset",
+        "skin1",
+        "--r-max",
+        "60",
+        "--steps",
+        "60000",
+    ]));
+    for ch in 0..3 {
+        let mut prev = (0.0, 0.0);
+        let mut integral = 0.0;
+        for row in &csv.rows {
+            let f = 2.0 * std::f64::consts::PI * row[0] * row[1 + ch];
+            integral += 0.5 * (f + prev.1) * (row[0] - prev.0);
+            prev = (row[0], f);
+        }
+        let total = csv.total[ch];
+        assert!(
+            rel_close(integral, total, 2e-3),
+            "channel {ch}: trapezoid {integral} vs printed total {total}"
+        );
+    }
+}
+
+#[test]
+fn monte_carlo_profile_has_standard_errors_and_is_seeded() {
+    let args = [
+        "profile",
+        "--model",
+        "monte-carlo",
+        "--preset",
+        "skin1",
+        "--r-max",
+        "8",
+        "--steps",
+        "16",
+        "--photons",
+        "20000",
+        "--seed",
+        "7",
+    ];
+    let a = ok(&args);
+    let csv = parse_csv(&a);
+    assert_eq!(csv.header, "r_mm,rd_r,rd_g,rd_b,se_r,se_g,se_b");
+    assert_eq!(csv.rows.len(), 16);
+    // Bin centres of 16 bins over [0, 8].
+    assert!(rel_close(csv.rows[0][0], 0.25, 1e-12));
+    assert!(rel_close(csv.rows[15][0], 7.75, 1e-12));
+    for row in &csv.rows {
+        assert_eq!(row.len(), 7);
+        assert!(row[1..].iter().all(|v| *v >= 0.0));
+    }
+    assert!(csv.total.iter().all(|t| *t > 0.0 && *t < 1.0));
+    assert_eq!(a, ok(&args), "same seed, same output");
+}
+
+#[test]
+fn bad_input_fails_with_one_line_and_no_output() {
+    let dir = tmp_dir("bad");
+    let unwritable = dir.join("missing-dir").join("p.png");
+    let unwritable = unwritable.to_str().unwrap();
+    let base = ["profile", "--model", "better-dipole"];
+    let cases: Vec<Vec<&str>> = vec![
+        vec![
+            "profile", "--model", "nope", "--preset", "skin1", "--r-max", "1", "--steps", "3",
+        ],
+        [
+            &base[..],
+            &["--preset", "nope", "--r-max", "1", "--steps", "3"],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--sigma-a",
+                "-1,1,1",
+                "--sigma-s",
+                "1,1,1",
+                "--r-max",
+                "1",
+                "--steps",
+                "3",
+            ],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--sigma-a",
+                "NaN,1,1",
+                "--sigma-s",
+                "1,1,1",
+                "--r-max",
+                "1",
+                "--steps",
+                "3",
+            ],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--sigma-a",
+                "1,1,1",
+                "--sigma-s",
+                "1,nan,1",
+                "--r-max",
+                "1",
+                "--steps",
+                "3",
+            ],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--sigma-a",
+                "1,1",
+                "--sigma-s",
+                "1,1,1",
+                "--r-max",
+                "1",
+                "--steps",
+                "3",
+            ],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--sigma-a",
+                "1;1;1",
+                "--sigma-s",
+                "1,1,1",
+                "--r-max",
+                "1",
+                "--steps",
+                "3",
+            ],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &["--preset", "skin1", "--r-max", "0", "--steps", "3"],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &["--preset", "skin1", "--r-max", "-2", "--steps", "3"],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &["--preset", "skin1", "--r-max", "nan", "--steps", "3"],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &["--preset", "skin1", "--r-max", "1", "--steps", "0"],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--preset", "skin1", "--r-max", "1", "--steps", "3", "--plot", unwritable,
+            ],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--preset", "skin1", "--r-max", "1", "--steps", "3", "--plot", "p.pdf",
+            ],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--preset",
+                "skin1",
+                "--sigma-a",
+                "1,1,1",
+                "--sigma-s",
+                "1,1,1",
+                "--r-max",
+                "1",
+                "--steps",
+                "3",
+            ],
+        ]
+        .concat(),
+        [&base[..], &["--r-max", "1", "--steps", "3"]].concat(),
+        [
+            &base[..],
+            &[
+                "--preset", "skin1", "--eta", "0", "--r-max", "1", "--steps", "3",
+            ],
+        ]
+        .concat(),
+        [
+            &base[..],
+            &[
+                "--sigma-a",
+                "1,1,1",
+                "--sigma-s",
+                "1,1,1",
+                "--g",
+                "1",
+                "--r-max",
+                "1",
+                "--steps",
+                "3",
+            ],
+        ]
+        .concat(),
+        vec![
+            "profile",
+            "--model",
+            "monte-carlo",
+            "--preset",
+            "skin1",
+            "--r-max",
+            "1",
+            "--steps",
+            "3",
+            "--photons",
+            "0",
+        ],
+        vec![
+            "profile",
+            "--model",
+            "monte-carlo",
+            "--preset",
+            "skin1",
+            "--r-max",
+            "1",
+            "--steps",
+            "3",
+            "--log",
+        ],
+        vec![],
+        vec!["frobnicate"],
+    ];
+    for args in &cases {
+        let o = sss(args);
+        let err = stderr(&o);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert_ne!(o.status.code(), Some(101), "{args:?} panicked: {err}");
+        assert!(o.stdout.is_empty(), "{args:?} printed {:?}", stdout(&o));
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err:?}");
+        assert!(err.starts_with("error: "), "{args:?}: {err:?}");
+    }
+    assert!(!dir.join("missing-dir").exists());
+}
+
+#[test]
+fn plot_writes_png_and_svg() {
+    let dir = tmp_dir("plot");
+    for (model, file) in [
+        ("better-dipole", "profile.png"),
+        ("pbd", "profile.svg"),
+        ("monte-carlo", "mc.png"),
+    ] {
+        let path = dir.join(file);
+        let _ = std::fs::remove_file(&path);
+        let out = ok(&[
+            "profile",
+            "--model",
+            model,
+            "--preset",
+            "skin2",
+            "--r-max",
+            "10",
+            "--steps",
+            "40",
+            "--photons",
+            "5000",
+            "--plot",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.starts_with("# total_diffuse_reflectance="));
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(bytes.len() > 1000, "{file}: {} bytes", bytes.len());
+        if file.ends_with(".png") {
+            assert_eq!(&bytes[1..4], b"PNG");
+        } else {
+            assert!(String::from_utf8_lossy(&bytes).contains("<svg"));
+        }
+    }
+    // No temporary files left behind.
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        assert!(!name.starts_with('.'), "left over: {name}");
+    }
+}
+
+#[test]
+fn presets_lists_all_twelve() {
+    let table = ok(&["presets"]);
+    assert_eq!(table.lines().count(), 13);
+    let csv = ok(&["presets", "--csv"]);
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 13);
+    assert!(lines[0].starts_with("name,sigma_s_reduced_r,"));
+    for p in &PRESETS {
+        assert!(
+            table
+                .lines()
+                .any(|l| l.split_whitespace().next() == Some(p.name))
+        );
+        let row = lines
+            .iter()
+            .find(|l| l.split(',').next() == Some(p.name))
+            .unwrap_or_else(|| panic!("{} missing", p.name));
+        let v: Vec<f64> = row.split(',').skip(1).map(|x| x.parse().unwrap()).collect();
+        assert_eq!(v.len(), 10);
+        assert_eq!(&v[0..3], &p.sigma_s_reduced);
+        assert_eq!(&v[3..6], &p.sigma_a);
+        assert_eq!(v[6], 1.3);
+        assert_eq!(&v[7..10], &p.published_rd);
+    }
+}
+
+#[test]
+fn help_and_version_succeed() {
+    let h = ok(&["--help"]);
+    assert!(h.contains("profile") && h.contains("presets"));
+    let h = ok(&["profile", "--help"]);
+    assert!(h.contains("monte-carlo") && h.contains("--sigma-a"));
+    assert!(ok(&["--version"]).starts_with("sss "));
+}

@@ -1,0 +1,201 @@
+//! `cargo xtask compare`: the project's main measurement.
+//!
+//! 1. For every selected preset and channel, the Monte Carlo reference is loaded from the
+//!    cache or simulated ([`mod@reference`]).
+//! 2. Each registered [`Experiment`] uses the references and contributes a report
+//!    [`Section`] plus its own files (today: [`profiles::ProfileComparison`], every model's
+//!    radial profile against Monte Carlo; later issues add rendering methods here).
+//! 3. `report.md` is assembled from the sections.
+//!
+//! Everything random is seeded ([`Config::seed`]), so error figures are reproducible; only
+//! the timings vary from run to run.
+
+mod metrics;
+mod output;
+mod profiles;
+mod reference;
+
+use output::write_atomic;
+use reference::PresetReference;
+use sss_bssrdf::presets::{self, Preset};
+use std::fmt;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Presets of `--quick`: a typical translucent material (skin1), a nearly non-absorbing one
+/// (marble) and a strongly absorbing one (ketchup, whose blue channel reflects almost
+/// nothing).
+pub const QUICK_PRESETS: [&str; 3] = ["skin1", "marble", "ketchup"];
+
+/// Photons per channel of `--quick`.
+pub const QUICK_PHOTONS: u64 = 50_000;
+
+/// Photons per channel of a full run (about 4 minutes of simulation on 2 cores, most of it
+/// spectralon, whose albedo-1 walks are long; cached afterwards).
+pub const DEFAULT_PHOTONS: u64 = 100_000;
+
+/// What `compare` does.
+#[derive(Clone, Debug)]
+pub struct Config {
+    /// Preset names.
+    pub presets: Vec<String>,
+    /// Monte Carlo photons per channel.
+    pub photons: u64,
+    /// Monte Carlo seed.
+    pub seed: u64,
+    /// Radial bins per channel.
+    pub bins: usize,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Ignore cached references.
+    pub fresh: bool,
+}
+
+/// A failure, with a message for a person.
+#[derive(Debug)]
+pub struct Error(pub String);
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// What an experiment sees.
+pub struct Context<'a> {
+    /// The run's configuration (output directory, seed, …).
+    pub config: &'a Config,
+    /// The Monte Carlo reference of every selected preset, in the order given.
+    pub references: &'a [PresetReference],
+    /// Prints a progress line (above the progress bars, or plainly when stderr is not a
+    /// terminal).
+    pub log: &'a dyn Fn(&str),
+}
+
+/// An experiment's part of the report.
+pub struct Section {
+    /// Heading.
+    pub title: String,
+    /// Markdown for the summary at the top of the report.
+    pub summary: String,
+    /// Markdown with the details.
+    pub body: String,
+}
+
+/// One part of the comparison.
+pub trait Experiment {
+    /// Short name, for progress messages.
+    fn name(&self) -> &'static str;
+    /// Runs the experiment, writing its files under `ctx.config.out`.
+    fn run(&self, ctx: &Context<'_>) -> Result<Section, Error>;
+}
+
+/// Every experiment, in report order.
+fn experiments() -> Vec<Box<dyn Experiment>> {
+    vec![Box::new(profiles::ProfileComparison)]
+}
+
+fn check(config: &Config) -> Result<Vec<&'static Preset>, Error> {
+    if config.presets.is_empty() {
+        return Err(Error("no presets selected".into()));
+    }
+    if config.photons == 0 {
+        return Err(Error("--photons must be at least 1".into()));
+    }
+    if config.bins == 0 || config.bins > 100_000 {
+        return Err(Error(format!(
+            "--bins {} must lie in 1..=100000",
+            config.bins
+        )));
+    }
+    let mut out: Vec<&'static Preset> = Vec::new();
+    for name in &config.presets {
+        let p = presets::find(name).map_err(|e| {
+            let all: Vec<&str> = presets::PRESETS.iter().map(|p| p.name).collect();
+            Error(format!("{e}; known presets: {}", all.join(", ")))
+        })?;
+        if !out.iter().any(|q| q.name == p.name) {
+            out.push(p);
+        }
+    }
+    Ok(out)
+}
+
+/// Runs the whole comparison.
+pub fn run(config: &Config) -> Result<(), Error> {
+    let started = Instant::now();
+    let presets = check(config)?;
+    std::fs::create_dir_all(&config.out).map_err(|e| {
+        Error(format!(
+            "cannot create output directory '{}': {e}",
+            config.out.display()
+        ))
+    })?;
+    let bar = sss_render::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
+    let log = |msg: &str| {
+        if bar.is_hidden() {
+            eprintln!("{msg}");
+        } else {
+            bar.println(msg);
+        }
+    };
+    log(&format!(
+        "compare: {} preset(s), {} photons per channel, seed {}, {} bins -> {}",
+        presets.len(),
+        config.photons,
+        config.seed,
+        config.bins,
+        config.out.display()
+    ));
+    let references = reference::load_or_compute(config, &presets, &log, &bar)?;
+    bar.finish_and_clear();
+    let ctx = Context {
+        config,
+        references: &references,
+        log: &|msg| eprintln!("{msg}"),
+    };
+    let mut sections = Vec::new();
+    for exp in experiments() {
+        eprintln!("experiment {}", exp.name());
+        sections.push(exp.run(&ctx)?);
+    }
+    let report = assemble_report(config, &presets, &sections, started.elapsed().as_secs_f64());
+    let path = config.out.join("report.md");
+    write_atomic(&path, report.as_bytes())?;
+    eprintln!(
+        "compare: done in {:.1} s; wrote {}",
+        started.elapsed().as_secs_f64(),
+        path.display()
+    );
+    Ok(())
+}
+
+fn assemble_report(
+    config: &Config,
+    presets: &[&Preset],
+    sections: &[Section],
+    seconds: f64,
+) -> String {
+    let names: Vec<&str> = presets.iter().map(|p| p.name).collect();
+    let mut s = String::new();
+    s.push_str("# Subsurface-scattering models: comparison report\n\n");
+    s.push_str(&format!(
+        "Generated by `cargo xtask compare`. Presets: {}. Monte Carlo: {} photons per channel, \
+         seed {}, {} linear bins per channel over [0, r_max], r_max holding {:.0} % of the \
+         standard dipole's reflectance. Media: Jensen et al. 2001 Table 2 (g = 0, η = 1.3). \
+         Run time {seconds:.1} s.\n\n",
+        names.join(", "),
+        config.photons,
+        config.seed,
+        config.bins,
+        100.0 * reference::R_MAX_ENERGY,
+    ));
+    s.push_str("## Summary\n\n");
+    for sec in sections {
+        s.push_str(&format!("### {}\n\n{}\n", sec.title, sec.summary));
+    }
+    for sec in sections {
+        s.push_str(&format!("## {}\n\n{}\n", sec.title, sec.body));
+    }
+    s
+}

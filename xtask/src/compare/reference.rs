@@ -1,0 +1,288 @@
+//! The Monte Carlo reference of each (preset, channel), computed once and cached on disk.
+//!
+//! Each channel is its own simulation with its own radial range: r_max is the radius holding
+//! [`R_MAX_ENERGY`] of the standard dipole's reflectance in that channel, so the bins resolve
+//! the profile where it carries energy. The Monte Carlo code seeds its streams from
+//! (seed, channel, chunk), so a single-channel run gives the same numbers as that channel of
+//! a three-channel run.
+//!
+//! Cache files live in `<out>/cache/` and are named by everything that determines their
+//! content: preset, channel, photons, seed, bins, r_max (shortest round-trip notation) and
+//! [`CACHE_VERSION`]. Numbers are stored in round-trip notation, so a cached reference is
+//! bit-identical to a fresh one.
+
+use super::output::write_atomic;
+use super::{Config, Error};
+use sss_bssrdf::monte_carlo::{self, McConfig};
+use sss_bssrdf::presets::Preset;
+use sss_bssrdf::{Medium, ModelKind, make_model};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Fraction of the standard dipole's diffuse reflectance inside r_max.
+pub const R_MAX_ENERGY: f64 = 0.99;
+
+/// Bump when the cache file layout (or the meaning of its key) changes.
+pub const CACHE_VERSION: u32 = 1;
+
+/// Channel names used in file names, CSV and the report.
+pub const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
+
+/// The reference profile of one channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelReference {
+    /// Outer radius of the bins (mm).
+    pub r_max: f64,
+    /// `bins + 1` bin edges (mm).
+    pub edges: Vec<f64>,
+    /// Area-averaged R_d of each bin (1/mm²).
+    pub rd: Vec<f64>,
+    /// Standard error of each bin.
+    pub se: Vec<f64>,
+    /// Total diffuse reflectance (all radii).
+    pub total: f64,
+    /// Its standard error.
+    pub total_se: f64,
+    /// Photons stopped by the event cap.
+    pub capped: u64,
+    /// Seconds the simulation took (when it ran in this process).
+    pub seconds: Option<f64>,
+}
+
+impl ChannelReference {
+    /// Bin centres (mm).
+    pub fn centers(&self) -> Vec<f64> {
+        self.edges.windows(2).map(|e| 0.5 * (e[0] + e[1])).collect()
+    }
+
+    /// Annulus area of each bin (mm²).
+    pub fn areas(&self) -> Vec<f64> {
+        self.edges
+            .windows(2)
+            .map(|e| std::f64::consts::PI * (e[1] * e[1] - e[0] * e[0]))
+            .collect()
+    }
+}
+
+/// The reference of one preset.
+#[derive(Clone, Debug)]
+pub struct PresetReference {
+    /// The measured material.
+    pub preset: &'static Preset,
+    /// Its medium (g = 0, η = 1.3).
+    pub medium: Medium,
+    /// Red, green, blue.
+    pub channels: [ChannelReference; 3],
+}
+
+/// r_max of channel `ch`: the standard dipole's radius holding [`R_MAX_ENERGY`], guarded
+/// against degenerate answers (falls back to 50 reduced mean free paths).
+pub fn r_max_for(medium: &Medium, ch: usize) -> f64 {
+    let model = make_model(ModelKind::StandardDipole, medium);
+    let r = model.radius_for_energy(ch, R_MAX_ENERGY);
+    let mfp = medium.reduced_mean_free_path(ch);
+    if r.is_finite() && r > 0.0 {
+        r
+    } else {
+        50.0 * mfp
+    }
+}
+
+fn cache_path(dir: &Path, preset: &str, ch: usize, cfg: &McConfig) -> PathBuf {
+    dir.join(format!(
+        "mc-v{CACHE_VERSION}-{preset}-{}-p{}-s{}-b{}-r{:e}.csv",
+        CHANNEL_NAMES[ch], cfg.photons, cfg.seed, cfg.bins, cfg.r_max
+    ))
+}
+
+fn key_line(preset: &str, ch: usize, cfg: &McConfig) -> String {
+    format!(
+        "# sss monte-carlo reference v{CACHE_VERSION}: preset={preset} channel={} photons={} seed={} bins={} r_max={:e}",
+        CHANNEL_NAMES[ch], cfg.photons, cfg.seed, cfg.bins, cfg.r_max
+    )
+}
+
+fn serialize(key: &str, r: &ChannelReference) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "{key}");
+    let _ = writeln!(s, "# total,total_se,capped");
+    let _ = writeln!(s, "{:e},{:e},{}", r.total, r.total_se, r.capped);
+    let _ = writeln!(s, "# r0_mm,r1_mm,rd,se");
+    for i in 0..r.rd.len() {
+        let _ = writeln!(
+            s,
+            "{:e},{:e},{:e},{:e}",
+            r.edges[i],
+            r.edges[i + 1],
+            r.rd[i],
+            r.se[i]
+        );
+    }
+    s
+}
+
+/// Parses a cache file; `None` when it does not match `key` or is malformed (then the
+/// reference is recomputed).
+fn deserialize(text: &str, key: &str, cfg: &McConfig) -> Option<ChannelReference> {
+    let mut lines = text.lines();
+    if lines.next()? != key {
+        return None;
+    }
+    lines.next()?;
+    let head: Vec<&str> = lines.next()?.split(',').collect();
+    if head.len() != 3 {
+        return None;
+    }
+    let total: f64 = head[0].parse().ok()?;
+    let total_se: f64 = head[1].parse().ok()?;
+    let capped: u64 = head[2].parse().ok()?;
+    lines.next()?;
+    let mut edges = Vec::with_capacity(cfg.bins + 1);
+    let mut rd = Vec::with_capacity(cfg.bins);
+    let mut se = Vec::with_capacity(cfg.bins);
+    for line in lines {
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|x| x.parse::<f64>())
+            .collect::<Result<_, _>>()
+            .ok()?;
+        if v.len() != 4 || !v.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        if edges.is_empty() {
+            edges.push(v[0]);
+        }
+        edges.push(v[1]);
+        rd.push(v[2]);
+        se.push(v[3]);
+    }
+    if rd.len() != cfg.bins || !total.is_finite() || !total_se.is_finite() {
+        return None;
+    }
+    Some(ChannelReference {
+        r_max: cfg.r_max,
+        edges,
+        rd,
+        se,
+        total,
+        total_se,
+        capped,
+        seconds: None,
+    })
+}
+
+/// Loads or computes the references of every preset of `config`. `log` receives one line
+/// per channel; `on_photons(done, total)` reports simulation progress.
+pub fn load_or_compute(
+    config: &Config,
+    presets: &[&'static Preset],
+    log: &dyn Fn(&str),
+    bar: &indicatif::ProgressBar,
+) -> Result<Vec<PresetReference>, Error> {
+    let dir = config.out.join("cache");
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| Error(format!("cannot create '{}': {e}", dir.display())))?;
+    let mut out = Vec::with_capacity(presets.len());
+    for preset in presets {
+        let medium = Medium::preset(preset.name).map_err(|e| Error(e.to_string()))?;
+        let mut channels = Vec::with_capacity(3);
+        for (ch, channel_name) in CHANNEL_NAMES.iter().enumerate() {
+            let cfg = McConfig {
+                photons: config.photons,
+                seed: config.seed,
+                r_max: r_max_for(&medium, ch),
+                bins: config.bins,
+                channels: std::array::from_fn(|c| c == ch),
+            };
+            let path = cache_path(&dir, preset.name, ch, &cfg);
+            let key = key_line(preset.name, ch, &cfg);
+            let cached = if config.fresh {
+                None
+            } else {
+                std::fs::read_to_string(&path)
+                    .ok()
+                    .and_then(|t| deserialize(&t, &key, &cfg))
+            };
+            let reference = match cached {
+                Some(r) => {
+                    log(&format!(
+                        "{} {}: Monte Carlo reference from cache (r_max {:.3} mm)",
+                        preset.name, channel_name, cfg.r_max
+                    ));
+                    r
+                }
+                None => {
+                    bar.set_message(format!("{} {}", preset.name, channel_name));
+                    let base = bar.position();
+                    let t0 = Instant::now();
+                    let mc = monte_carlo::simulate_with_progress(&medium, &cfg, &|n| {
+                        bar.set_position(base + n)
+                    })
+                    .map_err(|e| Error(format!("Monte Carlo for {}: {e}", preset.name)))?;
+                    bar.set_position(base + cfg.photons);
+                    let seconds = t0.elapsed().as_secs_f64();
+                    let r = ChannelReference {
+                        r_max: cfg.r_max,
+                        edges: mc.bin_edges.clone(),
+                        rd: mc.rd[ch].clone(),
+                        se: mc.se[ch].clone(),
+                        total: mc.total[ch],
+                        total_se: mc.total_se[ch],
+                        capped: mc.capped,
+                        seconds: Some(seconds),
+                    };
+                    write_atomic(&path, serialize(&key, &r).as_bytes())?;
+                    log(&format!(
+                        "{} {}: Monte Carlo reference, {} photons in {seconds:.1} s (r_max {:.3} mm)",
+                        preset.name, channel_name, cfg.photons, cfg.r_max
+                    ));
+                    r
+                }
+            };
+            channels.push(reference);
+        }
+        let channels: [ChannelReference; 3] = channels
+            .try_into()
+            .map_err(|_| Error("internal: three channels expected".into()))?;
+        out.push(PresetReference {
+            preset,
+            medium,
+            channels,
+        });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cache_round_trip_is_exact() {
+        let cfg = McConfig {
+            photons: 10,
+            seed: 3,
+            r_max: 0.1 + 0.2,
+            bins: 2,
+            channels: [true, false, false],
+        };
+        let r = ChannelReference {
+            r_max: cfg.r_max,
+            edges: vec![0.0, 0.15000000000000002, 0.30000000000000004],
+            rd: vec![1.0 / 3.0, 1e-300],
+            se: vec![0.1, 0.0],
+            total: 0.7,
+            total_se: 0.01,
+            capped: 2,
+            seconds: None,
+        };
+        let key = key_line("skin1", 0, &cfg);
+        let text = serialize(&key, &r);
+        assert_eq!(deserialize(&text, &key, &cfg), Some(r));
+        // Another key or a truncated file is rejected.
+        assert_eq!(deserialize(&text, &key_line("skin2", 0, &cfg), &cfg), None);
+        let cut: String = text.lines().take(5).collect::<Vec<_>>().join("\n");
+        assert_eq!(deserialize(&cut, &key, &cfg), None);
+    }
+}
