@@ -91,7 +91,7 @@ impl fmt::Display for BssrdfError {
                 max,
             } => write!(
                 f,
-                "diffuse reflectance {requested} in channel {channel} is out of reach of the {model} model (its range is [0, {max:.6}])"
+                "diffuse reflectance {requested} in channel {channel} is out of reach of the {model} model for any albedo (it reaches at most {max:.6})"
             ),
             BssrdfError::InvalidArgument(msg) => f.write_str(msg),
         }

@@ -70,7 +70,7 @@ pub fn from_reflectance(
         let (mut lo, mut hi) = (0.0f64, 1.0f64);
         for _ in 0..200 {
             let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
+            if mid <= lo || mid >= hi || hi - lo < 1e-16 {
                 break;
             }
             if f(mid)? < target {
@@ -79,12 +79,18 @@ pub fn from_reflectance(
                 hi = mid;
             }
         }
-        // Return the end whose reflectance is closer to the target.
-        albedo[ch] = if (f(lo)? - target).abs() <= (f(hi)? - target).abs() {
-            lo
-        } else {
-            hi
-        };
+        // Return the end whose reflectance is closer to the target; a model whose total jumps
+        // (the directional dipole between α' = 0 and α' > 0) has gaps no albedo reaches.
+        let (e_lo, e_hi) = ((f(lo)? - target).abs(), (f(hi)? - target).abs());
+        albedo[ch] = if e_lo <= e_hi { lo } else { hi };
+        if e_lo.min(e_hi) > 1e-9 {
+            return Err(BssrdfError::UnreachableReflectance {
+                model: model.name(),
+                channel: ch,
+                requested: target,
+                max: r_hi,
+            });
+        }
     }
     Medium::from_extinction_albedo(sigma_t, albedo, g, eta)
 }
