@@ -140,6 +140,12 @@ pub struct McProfile {
     pub capped: u64,
     /// Weight still carried by capped photons / N, per channel (lost to the tally).
     pub capped_weight: Rgb,
+    /// The part of `rd` carried by photons that escaped after exactly one collision (single
+    /// scattering), per channel and bin (1/mm²). `rd − rd_single` is the multiple-scattering
+    /// profile that diffusion models (the dipoles) approximate.
+    pub rd_single: [Vec<f64>; 3],
+    /// The single-scattering part of `total`.
+    pub total_single: Rgb,
 }
 
 impl McProfile {
@@ -202,6 +208,8 @@ struct Walk {
 #[derive(Clone, Debug)]
 struct Tally {
     sum: Vec<f64>,
+    single: Vec<f64>,
+    single_total: f64,
     sum_sq: Vec<f64>,
     total: f64,
     total_sq: f64,
@@ -213,6 +221,8 @@ impl Tally {
     fn new(bins: usize) -> Self {
         Tally {
             sum: vec![0.0; bins],
+            single: vec![0.0; bins],
+            single_total: 0.0,
             sum_sq: vec![0.0; bins],
             total: 0.0,
             total_sq: 0.0,
@@ -228,6 +238,10 @@ impl Tally {
         for (a, b) in self.sum_sq.iter_mut().zip(&other.sum_sq) {
             *a += b;
         }
+        for (a, b) in self.single.iter_mut().zip(&other.single) {
+            *a += b;
+        }
+        self.single_total += other.single_total;
         self.total += other.total;
         self.total_sq += other.total_sq;
         self.capped += other.capped;
@@ -238,6 +252,9 @@ impl Tally {
 /// One photon's deposits, accumulated before they are squared.
 struct PhotonScratch {
     bin_weight: Vec<f64>,
+    /// Single-scattering deposits go straight to the tally (means only, no variance).
+    single: Vec<f64>,
+    single_total: f64,
     touched: Vec<usize>,
     total: f64,
 }
@@ -251,6 +268,13 @@ impl PhotonScratch {
                 self.touched.push(b);
             }
             self.bin_weight[b] += w;
+        }
+    }
+
+    fn deposit_single(&mut self, walk: &Walk, r: f64, w: f64) {
+        self.single_total += w;
+        if r < walk.r_max {
+            self.single[((r * walk.inv_dr) as usize).min(walk.bins - 1)] += w;
         }
     }
 
@@ -348,7 +372,11 @@ fn trace_photon(walk: &Walk, rng: &mut Pcg64Mcg, scratch: &mut PhotonScratch) ->
                     let f = fr_dielectric(d.z, walk.eta_out);
                     let escaped = w * (1.0 - f);
                     if escaped > 0.0 {
-                        scratch.deposit(walk, p.x.hypot(p.y), escaped);
+                        let r = p.x.hypot(p.y);
+                        scratch.deposit(walk, r, escaped);
+                        if events == 1 {
+                            scratch.deposit_single(walk, r, escaped);
+                        }
                     }
                     w *= f;
                     if w <= 0.0 {
@@ -384,6 +412,8 @@ fn run_chunk(walk: &Walk, photons: u64, seed: u64) -> Tally {
     let mut tally = Tally::new(walk.bins);
     let mut scratch = PhotonScratch {
         bin_weight: vec![0.0; walk.bins],
+        single: vec![0.0; walk.bins],
+        single_total: 0.0,
         touched: Vec::new(),
         total: 0.0,
     };
@@ -394,6 +424,8 @@ fn run_chunk(walk: &Walk, photons: u64, seed: u64) -> Tally {
         }
         scratch.flush(&mut tally);
     }
+    tally.single = std::mem::take(&mut scratch.single);
+    tally.single_total = scratch.single_total;
     tally
 }
 
@@ -469,16 +501,20 @@ pub(crate) fn simulate_impl(
     let mut total_se = [0.0; 3];
     let mut capped_weight = [0.0; 3];
     let mut capped = 0;
+    let mut rd_single: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; bins]);
+    let mut total_single = [0.0; 3];
     for ch in (0..3).filter(|&ch| cfg.channels[ch]) {
         let t = &tallies[ch];
         for b in 0..bins {
             let area = areas[b];
             if area > 0.0 {
                 rd[ch][b] = t.sum[b] / (n * area);
+                rd_single[ch][b] = t.single[b] / (n * area);
                 se[ch][b] = standard_error(t.sum[b], t.sum_sq[b], n) / area;
             }
         }
         total[ch] = t.total / n;
+        total_single[ch] = t.single_total / n;
         total_se[ch] = standard_error(t.total, t.total_sq, n);
         capped_weight[ch] = t.capped_weight / n;
         capped += t.capped;
@@ -492,6 +528,8 @@ pub(crate) fn simulate_impl(
         photons: cfg.photons,
         capped,
         capped_weight,
+        rd_single,
+        total_single,
     })
 }
 
@@ -716,6 +754,20 @@ mod tests {
             );
             assert!(prof.total[0] > 0.98, "eta {eta}: total {}", prof.total[0]);
         }
+    }
+
+    #[test]
+    fn single_scattering_tally_is_the_one_collision_part() {
+        // With the cap at one collision every escaping photon is singly scattered, so the
+        // split must equal the whole; without the cap it is a strict part of it.
+        let m = medium(0.9, 0.3, 1.3);
+        let c = cfg(20_000, 5, 4.0, 16);
+        let one = simulate_impl(&m, &c, 1, &|_| {}).unwrap();
+        assert_eq!(one.total_single[0], one.total[0]);
+        assert_eq!(one.rd_single[0], one.rd[0]);
+        let all = simulate(&m, &c).unwrap();
+        assert!(all.total_single[0] < all.total[0]);
+        assert!(all.rd_single[0].iter().zip(&all.rd[0]).all(|(s, t)| s <= t));
     }
 
     #[test]

@@ -226,51 +226,61 @@ fn reflectance_inversion_round_trips() {
 
 #[test]
 fn models_against_monte_carlo() {
-    // Photon beam diffusion models single and multiple scattering; the dipoles model multiple
-    // scattering only. Against the full Monte Carlo profile (which contains both), Habel et
-    // al. 2013 (Fig. 8-9) report PBD closer than either dipole; we assert that ordering and
-    // that PBD's profile error is small, measured as the relative L2 error of the energy in
-    // each radial bin.
+    // Error measure: relative L2 error of the energy in each radial bin, model against the
+    // Monte Carlo tally. The dipoles model multiple scattering only, so they are measured
+    // against the Monte Carlo multiple-scattering part (total minus photons that escaped after
+    // one collision); photon beam diffusion models both and is measured against the total.
+    // Orderings asserted, as the literature establishes them:
+    // - d'Eon 2012: the better dipole is closer to multiple scattering than the standard one;
+    // - Habel et al. 2013: PBD is closer to the full transport than either dipole.
     let m = Medium::preset("skin1").unwrap();
-    let r_max = 8.0;
     let bins = 40;
     let mc = simulate(
         &m,
         &McConfig {
             photons: 100_000,
             seed: 11,
-            r_max,
+            r_max: 8.0,
             bins,
             channels: [true; 3],
         },
     )
     .unwrap();
-    let error = |model: &dyn Bssrdf, ch: usize| {
+    let error = |kind: ModelKind, ch: usize, reference: &[f64]| {
+        let model = make_model(kind, &m);
         let (mut num, mut den) = (0.0, 0.0);
         for b in 0..bins {
             let (lo, hi) = (mc.bin_edges[b], mc.bin_edges[b + 1]);
             let area = std::f64::consts::PI * (hi * hi - lo * lo);
             let mass = integrate(&|r| TWO_PI * r * model.rd(ch, r), lo, hi, 8);
-            num += (mass - mc.rd[ch][b] * area).powi(2);
-            den += (mc.rd[ch][b] * area).powi(2);
+            num += (mass - reference[b] * area).powi(2);
+            den += (reference[b] * area).powi(2);
         }
         (num / den).sqrt()
     };
     for ch in 0..3 {
-        let e: Vec<f64> = ModelKind::ALL
+        let multiple: Vec<f64> = mc.rd[ch]
             .iter()
-            .map(|&k| error(make_model(k, &m).as_ref(), ch))
+            .zip(&mc.rd_single[ch])
+            .map(|(t, s)| t - s)
             .collect();
-        let (sd, bd, pbd) = (e[0], e[1], e[3]);
+        let sd = error(ModelKind::StandardDipole, ch, &multiple);
+        let bd = error(ModelKind::BetterDipole, ch, &multiple);
+        assert!(
+            bd < sd,
+            "ch{ch}: better dipole {bd} vs standard dipole {sd}"
+        );
+        let full = &mc.rd[ch];
+        let pbd = error(ModelKind::PhotonBeamDiffusion, ch, full);
         assert!(pbd < 0.15, "ch{ch}: PBD error {pbd}");
-        assert!(pbd < sd && pbd < bd, "ch{ch}: errors {e:?}");
+        for kind in [ModelKind::StandardDipole, ModelKind::BetterDipole] {
+            let e = error(kind, ch, full);
+            assert!(pbd < e, "ch{ch}: PBD {pbd} vs {kind} {e}");
+        }
         // Totals: PBD within 10 % of the Monte Carlo total reflectance.
         let pbd_total =
             make_model(ModelKind::PhotonBeamDiffusion, &m).total_diffuse_reflectance(ch);
-        assert!(
-            (pbd_total / mc.total[ch] - 1.0).abs() < 0.1,
-            "ch{ch}: {pbd_total} vs {}",
-            mc.total[ch]
-        );
+        let rel = (pbd_total / mc.total[ch] - 1.0).abs();
+        assert!(rel < 0.1, "ch{ch}: {pbd_total} vs {}", mc.total[ch]);
     }
 }
