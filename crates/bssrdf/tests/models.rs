@@ -249,12 +249,12 @@ fn models_against_monte_carlo() {
     let error = |kind: ModelKind, ch: usize, reference: &[f64]| {
         let model = make_model(kind, &m);
         let (mut num, mut den) = (0.0, 0.0);
-        for b in 0..bins {
-            let (lo, hi) = (mc.bin_edges[b], mc.bin_edges[b + 1]);
+        for (edge, &want) in mc.bin_edges.windows(2).zip(reference) {
+            let (lo, hi) = (edge[0], edge[1]);
             let area = std::f64::consts::PI * (hi * hi - lo * lo);
             let mass = integrate(&|r| TWO_PI * r * model.rd(ch, r), lo, hi, 8);
-            num += (mass - reference[b] * area).powi(2);
-            den += (reference[b] * area).powi(2);
+            num += (mass - want * area).powi(2);
+            den += (want * area).powi(2);
         }
         (num / den).sqrt()
     };
