@@ -24,7 +24,7 @@ use std::time::Instant;
 pub const R_MAX_ENERGY: f64 = 0.99;
 
 /// Bump when the cache file layout (or the meaning of its key) changes.
-pub const CACHE_VERSION: u32 = 1;
+pub const CACHE_VERSION: u32 = 2;
 
 /// Channel names used in file names, CSV and the report.
 pub const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
@@ -40,17 +40,62 @@ pub struct ChannelReference {
     pub rd: Vec<f64>,
     /// Standard error of each bin.
     pub se: Vec<f64>,
+    /// The single-scattering part of `rd` (photons that escaped after one collision).
+    pub rd_single: Vec<f64>,
     /// Total diffuse reflectance (all radii).
     pub total: f64,
     /// Its standard error.
     pub total_se: f64,
+    /// The single-scattering part of `total`.
+    pub total_single: f64,
     /// Photons stopped by the event cap.
     pub capped: u64,
     /// Seconds the simulation took (when it ran in this process).
     pub seconds: Option<f64>,
 }
 
+/// Which part of the Monte Carlo transport a method is measured against.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum McPart {
+    /// Everything that escaped (single and multiple scattering).
+    All,
+    /// Multiple scattering only: the total minus the photons that escaped after exactly one
+    /// collision. Diffusion models (the dipoles) approximate this part.
+    Multiple,
+}
+
+impl McPart {
+    /// Name in the CSV and report (`all`, `multiple`).
+    pub fn name(self) -> &'static str {
+        match self {
+            McPart::All => "all",
+            McPart::Multiple => "multiple",
+        }
+    }
+}
+
 impl ChannelReference {
+    /// The binned R_d of `part`.
+    pub fn rd_of(&self, part: McPart) -> Vec<f64> {
+        match part {
+            McPart::All => self.rd.clone(),
+            McPart::Multiple => self
+                .rd
+                .iter()
+                .zip(&self.rd_single)
+                .map(|(t, s)| (t - s).max(0.0))
+                .collect(),
+        }
+    }
+
+    /// The total diffuse reflectance of `part`.
+    pub fn total_of(&self, part: McPart) -> f64 {
+        match part {
+            McPart::All => self.total,
+            McPart::Multiple => (self.total - self.total_single).max(0.0),
+        }
+    }
+
     /// Bin centres (mm).
     pub fn centers(&self) -> Vec<f64> {
         self.edges.windows(2).map(|e| 0.5 * (e[0] + e[1])).collect()
@@ -106,17 +151,22 @@ fn key_line(preset: &str, ch: usize, cfg: &McConfig) -> String {
 fn serialize(key: &str, r: &ChannelReference) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{key}");
-    let _ = writeln!(s, "# total,total_se,capped");
-    let _ = writeln!(s, "{:e},{:e},{}", r.total, r.total_se, r.capped);
-    let _ = writeln!(s, "# r0_mm,r1_mm,rd,se");
+    let _ = writeln!(s, "# total,total_se,total_single,capped");
+    let _ = writeln!(
+        s,
+        "{:e},{:e},{:e},{}",
+        r.total, r.total_se, r.total_single, r.capped
+    );
+    let _ = writeln!(s, "# r0_mm,r1_mm,rd,se,rd_single");
     for i in 0..r.rd.len() {
         let _ = writeln!(
             s,
-            "{:e},{:e},{:e},{:e}",
+            "{:e},{:e},{:e},{:e},{:e}",
             r.edges[i],
             r.edges[i + 1],
             r.rd[i],
-            r.se[i]
+            r.se[i],
+            r.rd_single[i]
         );
     }
     s
@@ -131,23 +181,25 @@ fn deserialize(text: &str, key: &str, cfg: &McConfig) -> Option<ChannelReference
     }
     lines.next()?;
     let head: Vec<&str> = lines.next()?.split(',').collect();
-    if head.len() != 3 {
+    if head.len() != 4 {
         return None;
     }
     let total: f64 = head[0].parse().ok()?;
     let total_se: f64 = head[1].parse().ok()?;
-    let capped: u64 = head[2].parse().ok()?;
+    let total_single: f64 = head[2].parse().ok()?;
+    let capped: u64 = head[3].parse().ok()?;
     lines.next()?;
     let mut edges = Vec::with_capacity(cfg.bins + 1);
     let mut rd = Vec::with_capacity(cfg.bins);
     let mut se = Vec::with_capacity(cfg.bins);
+    let mut rd_single = Vec::with_capacity(cfg.bins);
     for line in lines {
         let v: Vec<f64> = line
             .split(',')
             .map(|x| x.parse::<f64>())
             .collect::<Result<_, _>>()
             .ok()?;
-        if v.len() != 4 || !v.iter().all(|x| x.is_finite()) {
+        if v.len() != 5 || !v.iter().all(|x| x.is_finite()) {
             return None;
         }
         if edges.is_empty() {
@@ -156,8 +208,13 @@ fn deserialize(text: &str, key: &str, cfg: &McConfig) -> Option<ChannelReference
         edges.push(v[1]);
         rd.push(v[2]);
         se.push(v[3]);
+        rd_single.push(v[4]);
     }
-    if rd.len() != cfg.bins || !total.is_finite() || !total_se.is_finite() {
+    if rd.len() != cfg.bins
+        || ![total, total_se, total_single]
+            .iter()
+            .all(|x| x.is_finite())
+    {
         return None;
     }
     Some(ChannelReference {
@@ -165,8 +222,10 @@ fn deserialize(text: &str, key: &str, cfg: &McConfig) -> Option<ChannelReference
         edges,
         rd,
         se,
+        rd_single,
         total,
         total_se,
+        total_single,
         capped,
         seconds: None,
     })
@@ -227,8 +286,10 @@ pub fn load_or_compute(
                         edges: mc.bin_edges.clone(),
                         rd: mc.rd[ch].clone(),
                         se: mc.se[ch].clone(),
+                        rd_single: mc.rd_single[ch].clone(),
                         total: mc.total[ch],
                         total_se: mc.total_se[ch],
+                        total_single: mc.total_single[ch],
                         capped: mc.capped,
                         seconds: Some(seconds),
                     };
@@ -272,8 +333,10 @@ mod tests {
             edges: vec![0.0, 0.15000000000000002, 0.30000000000000004],
             rd: vec![1.0 / 3.0, 1e-300],
             se: vec![0.1, 0.0],
+            rd_single: vec![0.125, 0.0],
             total: 0.7,
             total_se: 0.01,
+            total_single: 0.2,
             capped: 2,
             seconds: None,
         };
@@ -284,5 +347,12 @@ mod tests {
         assert_eq!(deserialize(&text, &key_line("skin2", 0, &cfg), &cfg), None);
         let cut: String = text.lines().take(5).collect::<Vec<_>>().join("\n");
         assert_eq!(deserialize(&cut, &key, &cfg), None);
+        let parsed = deserialize(&text, &key, &cfg).unwrap();
+        assert_eq!(
+            parsed.rd_of(McPart::Multiple),
+            vec![1.0 / 3.0 - 0.125, 1e-300]
+        );
+        assert!((parsed.total_of(McPart::Multiple) - 0.5).abs() < 1e-15);
+        assert_eq!(parsed.total_of(McPart::All), 0.7);
     }
 }
