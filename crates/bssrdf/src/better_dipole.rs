@@ -15,7 +15,7 @@
 //! the total is exactly 1. The fluence difference (e^{−σa} − e^{−σb})/σ is evaluated with
 //! `expm1` so that σ_tr → 0 (albedo → 1) stays accurate.
 
-use crate::radial::{exponential_pdf, exponential_sample, invert_tail};
+use crate::radial::ClosedFormTail;
 use crate::{Bssrdf, Medium, ModelKind, fresnel};
 
 /// (e^{−σa} − e^{−σb})/σ for b ≥ a ≥ 0, stable as σ → 0 (where it tends to b − a).
@@ -55,7 +55,9 @@ impl Channel {
                 + self.z_v * (1.0 + self.sigma_tr * dv) * ev / (dv * dv * dv));
         (self.alpha_p * self.alpha_p / (4.0 * std::f64::consts::PI) * (phi + flux)).max(0.0)
     }
+}
 
+impl ClosedFormTail for Channel {
     fn tail(&self, r: f64) -> f64 {
         let (dr, dv) = (r.hypot(self.z_r), r.hypot(self.z_v));
         // d_v − d_r without cancellation.
@@ -70,6 +72,14 @@ impl Channel {
 
     fn density(&self, r: f64) -> f64 {
         2.0 * std::f64::consts::PI * r * self.rd(r)
+    }
+
+    fn total(&self) -> f64 {
+        self.total
+    }
+
+    fn scale(&self) -> f64 {
+        self.z_r
     }
 }
 
@@ -124,43 +134,12 @@ impl Bssrdf for BetterDipole {
         self.ch[ch].total
     }
     fn sample_sr(&self, ch: usize, u: f64) -> f64 {
-        let c = &self.ch[ch];
-        if !(c.total > 0.0) {
-            return exponential_sample(c.z_r, u);
-        }
-        let u = if u.is_finite() {
-            u.clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        invert_tail(
-            &|r| c.tail(r),
-            &|r| c.density(r),
-            (1.0 - u) * c.total,
-            c.z_r,
-        )
+        self.ch[ch].sample(u)
     }
     fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
-        let c = &self.ch[ch];
-        if !(c.total > 0.0) {
-            return exponential_pdf(c.z_r, r);
-        }
-        if !(r >= 0.0) || !r.is_finite() {
-            return 0.0;
-        }
-        c.density(r) / c.total
+        self.ch[ch].pdf(r)
     }
     fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64 {
-        let c = &self.ch[ch];
-        let f = fraction.clamp(0.0, 1.0 - 1e-15);
-        if !(c.total > 0.0) {
-            return exponential_sample(c.z_r, f);
-        }
-        invert_tail(
-            &|r| c.tail(r),
-            &|r| c.density(r),
-            (1.0 - f) * c.total,
-            c.z_r,
-        )
+        self.ch[ch].radius_for_energy(fraction)
     }
 }

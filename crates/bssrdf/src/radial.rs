@@ -255,6 +255,56 @@ pub fn exponential_pdf(scale: f64, r: f64) -> f64 {
     (-r / scale).exp() / scale
 }
 
+/// A radial profile whose tail mass T(r) = ∫_r^∞ 2πr' R_d(r') dr' has a closed form (the
+/// standard and better dipole). Implementors give T, the density 2πr R_d(r) and a length
+/// scale; exact sampling, pdf and energy radii follow from [`invert_tail`], with the
+/// exponential fallback when the profile is identically zero.
+pub trait ClosedFormTail {
+    /// T(r); T(0) is the total diffuse reflectance.
+    fn tail(&self, r: f64) -> f64;
+    /// 2πr R_d(r).
+    fn density(&self, r: f64) -> f64;
+    /// The total T(0), clamped to [0, 1].
+    fn total(&self) -> f64;
+    /// Length scale of the profile (mm): the reduced mean free path.
+    fn scale(&self) -> f64;
+
+    /// r with density 2πr R_d(r)/T(0), by solving T(r) = (1 − u) T(0).
+    fn sample(&self, u: f64) -> f64 {
+        if !(self.total() > 0.0) {
+            return exponential_sample(self.scale(), u);
+        }
+        let u = if u.is_finite() {
+            u.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let target = (1.0 - u) * self.total();
+        invert_tail(
+            &|r| self.tail(r),
+            &|r| self.density(r),
+            target,
+            self.scale(),
+        )
+    }
+
+    /// Density of [`ClosedFormTail::sample`] per unit radius.
+    fn pdf(&self, r: f64) -> f64 {
+        if !(self.total() > 0.0) {
+            return exponential_pdf(self.scale(), r);
+        }
+        if !(r >= 0.0) || !r.is_finite() {
+            return 0.0;
+        }
+        self.density(r) / self.total()
+    }
+
+    /// The radius holding `fraction` of the total.
+    fn radius_for_energy(&self, fraction: f64) -> f64 {
+        self.sample(fraction.clamp(0.0, 1.0 - 1e-15))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

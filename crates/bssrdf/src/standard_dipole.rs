@@ -17,7 +17,7 @@
 //! ([`crate::fresnel::diffuse_fresnel_reflectance`] at 1/η) rather than the paper's polynomial
 //! fit (they agree to about 1 %).
 
-use crate::radial::{exponential_pdf, exponential_sample, invert_tail};
+use crate::radial::ClosedFormTail;
 use crate::{Bssrdf, Medium, ModelKind, fresnel};
 
 /// Per-channel constants of the dipole.
@@ -45,7 +45,9 @@ impl Channel {
             * (self.term(self.z_r, r) + self.term(self.z_v, r));
         v.max(0.0)
     }
+}
 
+impl ClosedFormTail for Channel {
     fn tail(&self, r: f64) -> f64 {
         let t = |z: f64| {
             let d = r.hypot(z);
@@ -56,6 +58,14 @@ impl Channel {
 
     fn density(&self, r: f64) -> f64 {
         2.0 * std::f64::consts::PI * r * self.rd(r)
+    }
+
+    fn total(&self) -> f64 {
+        self.total
+    }
+
+    fn scale(&self) -> f64 {
+        self.z_r
     }
 }
 
@@ -112,43 +122,12 @@ impl Bssrdf for StandardDipole {
         self.ch[ch].total
     }
     fn sample_sr(&self, ch: usize, u: f64) -> f64 {
-        let c = &self.ch[ch];
-        if !(c.total > 0.0) {
-            return exponential_sample(c.z_r, u);
-        }
-        let u = if u.is_finite() {
-            u.clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        invert_tail(
-            &|r| c.tail(r),
-            &|r| c.density(r),
-            (1.0 - u) * c.total,
-            c.z_r,
-        )
+        self.ch[ch].sample(u)
     }
     fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
-        let c = &self.ch[ch];
-        if !(c.total > 0.0) {
-            return exponential_pdf(c.z_r, r);
-        }
-        if !(r >= 0.0) || !r.is_finite() {
-            return 0.0;
-        }
-        c.density(r) / c.total
+        self.ch[ch].pdf(r)
     }
     fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64 {
-        let c = &self.ch[ch];
-        let f = fraction.clamp(0.0, 1.0 - 1e-15);
-        if !(c.total > 0.0) {
-            return exponential_sample(c.z_r, f);
-        }
-        invert_tail(
-            &|r| c.tail(r),
-            &|r| c.density(r),
-            (1.0 - f) * c.total,
-            c.z_r,
-        )
+        self.ch[ch].radius_for_energy(fraction)
     }
 }
