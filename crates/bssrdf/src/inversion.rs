@@ -67,21 +67,24 @@ pub fn from_reflectance(
                 max: r_hi,
             });
         }
+        // Bisection, keeping the reflectance at both ends of the bracket.
         let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        let (mut f_lo, mut f_hi) = (r_lo, r_hi);
         for _ in 0..200 {
             let mid = 0.5 * (lo + hi);
             if mid <= lo || mid >= hi || hi - lo < 1e-16 {
                 break;
             }
-            if f(mid)? < target {
-                lo = mid;
+            let f_mid = f(mid)?;
+            if f_mid < target {
+                (lo, f_lo) = (mid, f_mid);
             } else {
-                hi = mid;
+                (hi, f_hi) = (mid, f_mid);
             }
         }
         // Return the end whose reflectance is closer to the target; a model whose total jumps
         // (the directional dipole between α' = 0 and α' > 0) has gaps no albedo reaches.
-        let (e_lo, e_hi) = ((f(lo)? - target).abs(), (f(hi)? - target).abs());
+        let (e_lo, e_hi) = ((f_lo - target).abs(), (f_hi - target).abs());
         albedo[ch] = if e_lo <= e_hi { lo } else { hi };
         if e_lo.min(e_hi) > 1e-9 {
             return Err(BssrdfError::UnreachableReflectance {

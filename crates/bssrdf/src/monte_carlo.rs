@@ -204,6 +204,13 @@ struct Walk {
     bins: usize,
 }
 
+impl Walk {
+    /// The radial bin holding exit radius `r`, or `None` beyond `r_max`.
+    fn bin(&self, r: f64) -> Option<usize> {
+        (r < self.r_max).then(|| ((r * self.inv_dr) as usize).min(self.bins - 1))
+    }
+}
+
 /// Sums of one channel over a set of photons.
 #[derive(Clone, Debug)]
 struct Tally {
@@ -262,8 +269,7 @@ struct PhotonScratch {
 impl PhotonScratch {
     fn deposit(&mut self, walk: &Walk, r: f64, w: f64) {
         self.total += w;
-        if r < walk.r_max {
-            let b = ((r * walk.inv_dr) as usize).min(walk.bins - 1);
+        if let Some(b) = walk.bin(r) {
             if self.bin_weight[b] == 0.0 {
                 self.touched.push(b);
             }
@@ -273,8 +279,8 @@ impl PhotonScratch {
 
     fn deposit_single(&mut self, walk: &Walk, r: f64, w: f64) {
         self.single_total += w;
-        if r < walk.r_max {
-            self.single[((r * walk.inv_dr) as usize).min(walk.bins - 1)] += w;
+        if let Some(b) = walk.bin(r) {
+            self.single[b] += w;
         }
     }
 
