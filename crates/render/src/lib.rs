@@ -30,6 +30,7 @@ mod error;
 pub mod plot;
 pub mod presets_table;
 pub mod profile;
+pub mod scene;
 pub mod progress;
 
 pub use error::Error;

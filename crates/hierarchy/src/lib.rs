@@ -1,0 +1,1 @@
+//! # sss-hierarchy (placeholder, being written)

@@ -1,0 +1,1 @@
+//! The TOML scene format (serde structures). Being written.

@@ -1,0 +1,256 @@
+//! Scenes: what a scene file describes, after loading and validation.
+//!
+//! A [`Scene`] is plain data in world space: a pinhole [`Camera`], [`Light`]s, [`Material`]s and
+//! [`Object`]s whose triangle meshes are already transformed, cleaned (degenerate triangles
+//! dropped and counted) and given per-vertex shading normals. The file format (TOML) is
+//! documented in `scenes/README.md`; [`load`] reads it, [`builtin`] returns the scenes embedded
+//! in the repository.
+//!
+//! Units: lengths in scene units; each translucent material says how many scene units make a
+//! millimetre ([`Translucent::units_per_mm`]), since the models work in mm.
+
+mod format;
+mod load;
+mod shapes;
+
+pub use load::{BUILTIN_SCENES, LoadOptions, builtin, load, load_str};
+
+use glam::DVec3;
+use sss_bssrdf::{Medium, ModelKind, Rgb};
+use std::fmt;
+use std::path::PathBuf;
+
+/// A loaded, validated scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Short name (the file stem, or the built-in scene's name).
+    pub name: String,
+    /// The file it came from (`None` for scenes built in code).
+    pub path: Option<PathBuf>,
+    /// The camera.
+    pub camera: Camera,
+    /// Light sources (at least one).
+    pub lights: Vec<Light>,
+    /// Materials referenced by objects, by index. Only materials some object uses are kept.
+    pub materials: Vec<Material>,
+    /// Objects with their world-space meshes.
+    pub objects: Vec<Object>,
+    /// Non-fatal problems found while loading (dropped triangles, ...), each naming the file.
+    pub warnings: Vec<String>,
+}
+
+/// A pinhole camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: DVec3,
+    /// Point looked at.
+    pub target: DVec3,
+    /// Up hint (need not be orthogonal to the view direction, must not be parallel to it).
+    pub up: DVec3,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub vfov_deg: f64,
+    /// Image width in pixels (≥ 1).
+    pub width: u32,
+    /// Image height in pixels (≥ 1).
+    pub height: u32,
+    /// Camera samples per pixel (≥ 1); 1 means the pixel centre, more are stratified jittered
+    /// positions.
+    pub pixel_samples: u32,
+}
+
+/// A light source. Radiometric quantities are linear RGB.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    /// An isotropic point light of radiant intensity `intensity` (W/sr).
+    Point {
+        /// Position.
+        position: DVec3,
+        /// Radiant intensity per channel.
+        intensity: Rgb,
+    },
+    /// A distant light: parallel rays travelling along `direction` (unit), giving irradiance
+    /// `irradiance` on a surface facing it.
+    Directional {
+        /// Unit direction the light travels in (from the light towards the scene).
+        direction: DVec3,
+        /// Irradiance on a surface perpendicular to the rays.
+        irradiance: Rgb,
+    },
+    /// A one-sided parallelogram emitter `corner + s·edge_u + t·edge_v`, s, t ∈ [0, 1],
+    /// emitting constant radiance towards `edge_u × edge_v`.
+    Quad {
+        /// One corner.
+        corner: DVec3,
+        /// First edge.
+        edge_u: DVec3,
+        /// Second edge.
+        edge_v: DVec3,
+        /// Emitted radiance.
+        radiance: Rgb,
+    },
+    /// Constant radiance from every direction not blocked by the scene.
+    Environment {
+        /// Radiance.
+        radiance: Rgb,
+    },
+}
+
+/// A solid (3D) procedural texture, evaluated at world-space positions. For a translucent
+/// material it modulates the irradiance entering the surface (a pre-scatter texture); for a
+/// diffuse material it multiplies the albedo.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Texture {
+    /// A 3D checkerboard of cubes of side `scale`: `a` where ⌊x/s⌋+⌊y/s⌋+⌊z/s⌋ is even, `b`
+    /// otherwise.
+    Checker {
+        /// Cube side (scene units, > 0).
+        scale: f64,
+        /// First colour.
+        a: Rgb,
+        /// Second colour.
+        b: Rgb,
+    },
+    /// Stripes of period `period` along the unit axis `axis`: `a` on the first half of each
+    /// period, `b` on the second.
+    Stripes {
+        /// Unit axis.
+        axis: DVec3,
+        /// Period (scene units, > 0).
+        period: f64,
+        /// First colour.
+        a: Rgb,
+        /// Second colour.
+        b: Rgb,
+    },
+    /// Smooth value noise of feature size `scale`, blending `a` (noise 0) to `b` (noise 1);
+    /// deterministic for `seed`.
+    Noise {
+        /// Feature size (scene units, > 0).
+        scale: f64,
+        /// Seed of the lattice values.
+        seed: u64,
+        /// Colour at noise 0.
+        a: Rgb,
+        /// Colour at noise 1.
+        b: Rgb,
+    },
+}
+
+/// A translucent material: a BSSRDF model of a homogeneous medium.
+#[derive(Clone, Debug)]
+pub struct Translucent {
+    /// Which model renders it.
+    pub model: ModelKind,
+    /// The medium (coefficients in 1/mm).
+    pub medium: Medium,
+    /// Scene units per millimetre (> 0).
+    pub units_per_mm: f64,
+    /// Optional pre-scatter albedo texture (values in [0, 1]).
+    pub texture: Option<Texture>,
+}
+
+/// What a material is.
+#[derive(Clone, Debug)]
+pub enum MaterialKind {
+    /// Subsurface scattering.
+    Translucent(Translucent),
+    /// Opaque Lambertian reflection.
+    Diffuse {
+        /// Albedo in [0, 1] per channel.
+        albedo: Rgb,
+        /// Optional texture multiplying the albedo.
+        texture: Option<Texture>,
+    },
+}
+
+/// A named material.
+#[derive(Clone, Debug)]
+pub struct Material {
+    /// The name objects refer to it by.
+    pub name: String,
+    /// Its kind and parameters.
+    pub kind: MaterialKind,
+}
+
+/// A triangle mesh in world space.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions (finite).
+    pub positions: Vec<DVec3>,
+    /// Unit per-vertex shading normals, one per position, pointing out of the object.
+    pub normals: Vec<DVec3>,
+    /// Triangles as indices into `positions`, counter-clockwise seen from outside; none is
+    /// degenerate (zero area).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// An object: a mesh with a material.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// Name (from the file, or `object<N>`).
+    pub name: String,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+    /// World-space geometry (at least one triangle).
+    pub mesh: Mesh,
+}
+
+/// A problem with a scene file: which file, where in it (line or key, when known), and what.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneError {
+    /// The file (or built-in scene name) with the problem.
+    pub file: String,
+    /// 1-based line, when known.
+    pub line: Option<usize>,
+    /// The key or path of keys (`objects[2].material`), when known.
+    pub key: Option<String>,
+    /// What is wrong.
+    pub message: String,
+    /// What kind of problem: callers skip scenes whose mesh is absent, and fail on the rest.
+    pub kind: SceneErrorKind,
+}
+
+/// The kind of a [`SceneError`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneErrorKind {
+    /// The scene text is malformed or invalid (syntax, unknown key, bad value, bad mesh data).
+    Invalid,
+    /// A mesh file the scene names was not found in any searched directory.
+    MeshNotFound,
+    /// A file could not be read.
+    Io,
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some(line) = self.line {
+            write!(f, ":{line}")?;
+        }
+        if let Some(key) = &self.key {
+            write!(f, ": `{key}`")?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+impl Texture {
+    /// The texture's colour at world-space point `p`; every channel in [0, 1] when the
+    /// colours are.
+    pub fn eval(&self, p: DVec3) -> Rgb {
+        shapes::eval_texture(self, p)
+    }
+}
+
+impl Scene {
+    /// The translucent material of object `i`, if it has one.
+    pub fn translucent(&self, object: usize) -> Option<&Translucent> {
+        match &self.materials[self.objects[object].material].kind {
+            MaterialKind::Translucent(t) => Some(t),
+            MaterialKind::Diffuse { .. } => None,
+        }
+    }
+}

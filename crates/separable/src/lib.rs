@@ -1,0 +1,1 @@
+//! # sss-separable (placeholder, being written)
