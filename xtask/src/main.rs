@@ -47,9 +47,16 @@ struct CompareArgs {
     /// Output directory [default: WORKSPACE/target/compare].
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Recompute the Monte Carlo references even if cached.
+    /// Recompute the Monte Carlo and scene references even if cached.
     #[arg(long)]
     fresh: bool,
+    /// Comma-separated scenes: built-in names (sphere, toad, picnic, backlit, slab, bunny) or
+    /// scene-file paths [default: every built-in scene].
+    #[arg(long, value_delimiter = ',')]
+    scenes: Option<Vec<String>>,
+    /// Directory to search for meshes (repeatable) [default: SSS_MESH_DIR, ../shared/meshes].
+    #[arg(long, value_name = "DIR")]
+    mesh_dir: Vec<PathBuf>,
 }
 
 fn workspace_root() -> PathBuf {
@@ -95,6 +102,18 @@ fn main() -> ExitCode {
                     .out
                     .unwrap_or_else(|| workspace_root().join("target").join("compare")),
                 fresh: args.fresh,
+                scenes: args.scenes.unwrap_or_else(|| {
+                    sss_render::scene::BUILTIN_SCENES
+                        .iter()
+                        .map(|(n, _)| n.to_string())
+                        .collect()
+                }),
+                mesh_dirs: if args.mesh_dir.is_empty() {
+                    compare::default_mesh_dirs(&workspace_root())
+                } else {
+                    args.mesh_dir
+                },
+                quick: args.quick,
             };
             compare::run(&config)
         }

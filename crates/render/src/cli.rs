@@ -5,6 +5,7 @@
 use crate::Error;
 use crate::presets_table::presets_table;
 use crate::profile::{MediumSpec, ProfileModel, ProfileRequest, compute};
+use crate::render_cli::{DiffArgs, RenderArgs, run_diff, run_render};
 use clap::{ArgGroup, Args, Parser, Subcommand};
 use sss_bssrdf::Rgb;
 use std::ffi::OsString;
@@ -28,6 +29,10 @@ pub enum Command {
     Profile(ProfileArgs),
     /// List the measured materials of Jensen et al. 2001 (Table 2).
     Presets(PresetsArgs),
+    /// Render a scene's subsurface term with a reference integrator (EXR and/or PNG out).
+    Render(RenderArgs),
+    /// Compare two renders: error figures and a false-colour error map.
+    Diff(DiffArgs),
 }
 
 /// Arguments of `sss profile`.
@@ -132,6 +137,8 @@ impl ProfileArgs {
 pub fn run(cli: &Cli, out: &mut dyn Write) -> Result<(), Error> {
     let text = match &cli.command {
         Command::Presets(args) => presets_table(args.csv).into_bytes(),
+        Command::Render(args) => run_render(args)?.into_bytes(),
+        Command::Diff(args) => run_diff(args)?.into_bytes(),
         Command::Profile(args) => {
             let req = args.request()?;
             if let Some(path) = &args.plot {
@@ -195,7 +202,7 @@ pub fn main(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
                     eprintln!(
-                        "error: a subcommand is required (profile or presets); see `sss --help`"
+                        "error: a subcommand is required (profile, presets, render or diff); see `sss --help`"
                     );
                     return ExitCode::from(2);
                 }

@@ -1,6 +1,7 @@
 //! The crate's error type.
 
 use crate::plot::PlotError;
+use crate::scene::{SceneError, SceneErrorKind};
 use sss_bssrdf::BssrdfError;
 use std::fmt;
 
@@ -22,6 +23,9 @@ pub enum Error {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// A scene file is invalid, names a missing mesh, or cannot be read (exit code 2, or 1
+    /// for a read failure).
+    Scene(SceneError),
     /// A model produced a value that is not a finite number (exit code 1): a bug in the model,
     /// reported instead of printed.
     NonFinite(String),
@@ -33,6 +37,8 @@ impl Error {
         match self {
             Error::Input(_) | Error::Bssrdf(_) => 2,
             Error::Plot(PlotError::UnsupportedFormat(_)) => 2,
+            Error::Scene(e) if e.kind == SceneErrorKind::Io => 1,
+            Error::Scene(_) => 2,
             Error::Plot(_) | Error::Io { .. } | Error::NonFinite(_) => 1,
         }
     }
@@ -44,6 +50,7 @@ impl fmt::Display for Error {
             Error::Input(msg) | Error::NonFinite(msg) => f.write_str(msg),
             Error::Bssrdf(e) => write!(f, "{e}"),
             Error::Plot(e) => write!(f, "{e}"),
+            Error::Scene(e) => write!(f, "{e}"),
             Error::Io { what, source } => write!(f, "{what}: {source}"),
         }
     }
@@ -54,6 +61,7 @@ impl std::error::Error for Error {
         match self {
             Error::Bssrdf(e) => Some(e),
             Error::Plot(e) => Some(e),
+            Error::Scene(e) => Some(e),
             Error::Io { source, .. } => Some(source),
             _ => None,
         }
@@ -69,5 +77,11 @@ impl From<BssrdfError> for Error {
 impl From<PlotError> for Error {
     fn from(e: PlotError) -> Self {
         Error::Plot(e)
+    }
+}
+
+impl From<SceneError> for Error {
+    fn from(e: SceneError) -> Self {
+        Error::Scene(e)
     }
 }

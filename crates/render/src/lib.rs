@@ -25,12 +25,22 @@
 //! 2012, Frisvad et al. 2014, Habel et al. 2013) and its Monte Carlo reference (MCML, Wang et
 //! al. 1995).
 
+pub mod camera;
 pub mod cli;
 mod error;
+pub mod gbuffer;
+pub mod geometry;
+pub mod image;
+pub mod integrators;
+pub mod irradiance;
+pub mod lights;
 pub mod plot;
 pub mod presets_table;
 pub mod profile;
 pub mod scene;
 pub mod progress;
+pub mod render;
+pub mod render_cli;
+pub mod rng;
 
 pub use error::Error;

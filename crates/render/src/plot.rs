@@ -300,6 +300,12 @@ fn temp_path(path: &Path, format: PlotFormat) -> PathBuf {
     }
 }
 
+/// Registers the embedded font with plotters (once); other drawing code calls this before
+/// drawing text.
+pub fn ensure_font() -> Result<(), PlotError> {
+    register_font()
+}
+
 fn register_font() -> Result<(), PlotError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {

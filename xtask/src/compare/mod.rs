@@ -14,6 +14,9 @@ mod metrics;
 mod output;
 mod profiles;
 mod reference;
+mod scenes;
+
+pub use scenes::default_mesh_dirs;
 
 use output::write_atomic;
 use reference::PresetReference;
@@ -49,6 +52,12 @@ pub struct Config {
     pub out: PathBuf,
     /// Ignore cached references.
     pub fresh: bool,
+    /// Scenes to render: built-in names or scene-file paths.
+    pub scenes: Vec<String>,
+    /// Directories searched for meshes the scenes name.
+    pub mesh_dirs: Vec<PathBuf>,
+    /// The fast variant (smaller images, shorter sweeps).
+    pub quick: bool,
 }
 
 /// A failure, with a message for a person.
@@ -92,7 +101,10 @@ pub trait Experiment {
 
 /// Every experiment, in report order.
 fn experiments() -> Vec<Box<dyn Experiment>> {
-    vec![Box::new(profiles::ProfileComparison)]
+    vec![
+        Box::new(profiles::ProfileComparison),
+        Box::new(scenes::SceneComparison),
+    ]
 }
 
 fn check(config: &Config) -> Result<Vec<&'static Preset>, Error> {

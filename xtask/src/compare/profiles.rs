@@ -3,7 +3,7 @@
 //! For each preset and channel, each registered [`ProfileMethod`] is built, its area averages
 //! over the reference's bins are compared with the Monte Carlo bins ([`super::metrics`]), its
 //! total diffuse reflectance with the Monte Carlo total, and its evaluation cost is timed.
-//! Writes `results.csv`, `profile_<preset>.png`, `error_<preset>.png` and
+//! Writes `profiles.csv`, `profile_<preset>.png`, `error_<preset>.png` and
 //! `error_vs_cost.png`, and returns the report section.
 //!
 //! To add a method (e.g. a fitted kernel from a later crate), implement [`ProfileMethod`] and
@@ -167,10 +167,10 @@ pub fn evaluate(
     out
 }
 
-/// The header of `results.csv` (documented in README.md).
+/// The header of `profiles.csv` (documented in README.md).
 pub const CSV_HEADER: &str = "preset,model,channel,rel_l2_error,max_rel_error,total_model,total_mc,total_mc_se,ns_per_eval,build_seconds,mc_part";
 
-/// `results.csv`: one row per (preset, model, channel).
+/// `profiles.csv`: one row per (preset, model, channel).
 pub fn results_csv(evals: &[Evaluation]) -> String {
     let mut s = String::from(CSV_HEADER);
     s.push('\n');
@@ -494,7 +494,7 @@ impl Experiment for ProfileComparison {
         }
         bar.finish_and_clear();
         write_atomic(
-            &ctx.config.out.join("results.csv"),
+            &ctx.config.out.join("profiles.csv"),
             results_csv(&evals).as_bytes(),
         )?;
         plot_error_vs_cost(ctx, &evals, &method_names)?;
@@ -502,7 +502,7 @@ impl Experiment for ProfileComparison {
         let _ = writeln!(
             summary,
             "Error against run time, averaged over presets and channels (details per preset below; \
-             every number per (preset, model, channel) is in `results.csv`). Means are dominated by \
+             every number per (preset, model, channel) is in `profiles.csv`). Means are dominated by \
              the worst channels (strongly absorbing ones such as ketchup's green and blue, where \
              multiple scattering is almost nothing); the median shows the typical error.\n"
         );

@@ -1,0 +1,173 @@
+//! Direct light arriving at a surface point, with shadow rays: the irradiance that enters the
+//! translucent surfaces (irradiance samples, the path tracer's exit points) and lights the
+//! opaque ones.
+
+use crate::geometry::SceneGeometry;
+use crate::scene::Light;
+use glam::DVec3;
+use rand::RngExt;
+use rand_pcg::Pcg64Mcg;
+use sss_bssrdf::Rgb;
+use std::f64::consts::PI;
+
+/// One packet of light reaching a point: the unit direction it comes from and its
+/// contribution to the irradiance, `L cos θ dω / pdf` (no Fresnel factor; already shadowed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Incident {
+    /// Unit direction from the point towards the light.
+    pub dir: DVec3,
+    /// Irradiance contribution per channel (W per unit area), cos θ included.
+    pub e_cos: Rgb,
+}
+
+/// Gathers the direct light at `p` (unit shading normal `n`, geometric normal `ng`) into `out`:
+/// one packet per point or directional light that is above the surface and unblocked, and
+/// `area_samples` packets (each carrying 1/`area_samples` of the estimate) per quad or
+/// environment light. Packets with zero contribution are left out.
+pub fn gather(
+    geom: &SceneGeometry,
+    lights: &[Light],
+    p: DVec3,
+    n: DVec3,
+    ng: DVec3,
+    area_samples: u32,
+    rng: &mut Pcg64Mcg,
+    out: &mut Vec<Incident>,
+) {
+    let m = area_samples.max(1);
+    let eps = geom.epsilon();
+    for light in lights {
+        match light {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let d = *position - p;
+                let dist2 = d.length_squared();
+                if !(dist2 > 0.0) {
+                    continue;
+                }
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let cos = n.dot(wi);
+                if !(cos > 0.0) || ng.dot(wi) <= 0.0 {
+                    continue;
+                }
+                let o = geom.offset(p, ng, wi);
+                if geom.occluded(o, wi, 0.0, (dist - 4.0 * eps).max(0.0)) {
+                    continue;
+                }
+                let s = cos / dist2;
+                push(out, wi, intensity.map(|v| v * s));
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                let wi = -*direction;
+                let cos = n.dot(wi);
+                if !(cos > 0.0) || ng.dot(wi) <= 0.0 {
+                    continue;
+                }
+                let o = geom.offset(p, ng, wi);
+                if geom.occluded(o, wi, 0.0, f64::INFINITY) {
+                    continue;
+                }
+                push(out, wi, irradiance.map(|v| v * cos));
+            }
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => {
+                let cross = edge_u.cross(*edge_v);
+                let area = cross.length();
+                if !(area > 0.0) {
+                    continue;
+                }
+                let nl = cross / area;
+                for k in 0..m {
+                    let (s, t) = stratum(k, m, rng);
+                    let y = *corner + *edge_u * s + *edge_v * t;
+                    let d = y - p;
+                    let dist2 = d.length_squared();
+                    if !(dist2 > 0.0) {
+                        continue;
+                    }
+                    let dist = dist2.sqrt();
+                    let wi = d / dist;
+                    let cos = n.dot(wi);
+                    let cos_l = -nl.dot(wi);
+                    if !(cos > 0.0) || !(cos_l > 0.0) || ng.dot(wi) <= 0.0 {
+                        continue;
+                    }
+                    let o = geom.offset(p, ng, wi);
+                    if geom.occluded(o, wi, 0.0, (dist - 4.0 * eps).max(0.0)) {
+                        continue;
+                    }
+                    // L cos dω / pdf with pdf = 1/area over the quad and dω = cos_l dA / d².
+                    let s = cos * cos_l * area / (dist2 * m as f64);
+                    push(out, wi, radiance.map(|v| v * s));
+                }
+            }
+            Light::Environment { radiance } => {
+                let (t1, t2) = tangent_frame(n);
+                for k in 0..m {
+                    let (u1, u2) = stratum(k, m, rng);
+                    // Cosine-weighted hemisphere (Malley's method): L cos / (cos/π) = π L.
+                    let r = u1.sqrt();
+                    let phi = 2.0 * PI * u2;
+                    let z = (1.0 - u1).max(0.0).sqrt();
+                    let wi = (t1 * (r * phi.cos()) + t2 * (r * phi.sin()) + n * z).normalize();
+                    if ng.dot(wi) <= 0.0 {
+                        continue;
+                    }
+                    let o = geom.offset(p, ng, wi);
+                    if geom.occluded(o, wi, 0.0, f64::INFINITY) {
+                        continue;
+                    }
+                    let s = PI / m as f64;
+                    push(out, wi, radiance.map(|v| v * s));
+                }
+            }
+        }
+    }
+}
+
+fn push(out: &mut Vec<Incident>, dir: DVec3, e_cos: Rgb) {
+    if e_cos.iter().all(|v| v.is_finite() && *v >= 0.0) && e_cos.iter().any(|v| *v > 0.0) {
+        out.push(Incident { dir, e_cos });
+    }
+}
+
+/// A point of the unit square in stratum `k` of `m` equal strips along the first axis (uniform
+/// overall, with less variance than independent points).
+fn stratum(k: u32, m: u32, rng: &mut Pcg64Mcg) -> (f64, f64) {
+    let u = ((k as f64 + rng.random::<f64>()) / m as f64).min(1.0 - f64::EPSILON / 2.0);
+    (u, rng.random::<f64>())
+}
+
+/// Two unit tangents completing `n` to an orthonormal frame (Duff et al. 2017).
+pub fn tangent_frame(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// The radiance seen along a ray that leaves the scene: the environment lights' sum.
+pub fn background(lights: &[Light]) -> Rgb {
+    let mut l = [0.0; 3];
+    for light in lights {
+        if let Light::Environment { radiance } = light {
+            for c in 0..3 {
+                l[c] += radiance[c];
+            }
+        }
+    }
+    l
+}

@@ -1,0 +1,369 @@
+//! One render: scene → BVHs → G-buffer → (for the translucent objects the camera sees)
+//! models and irradiance samples → an integrator → the subsurface image, the total image and
+//! timings by stage.
+
+use crate::gbuffer::{GBuffer, GSample};
+use crate::geometry::SceneGeometry;
+use crate::integrators::pathtrace::{self, ProbeRadii};
+use crate::integrators::{TranslucentShading, exact, shading_for};
+use crate::irradiance::{self, IrradianceSettings, ObjectSamples};
+use crate::lights::{background, gather};
+use crate::rng::{Stream, rng};
+use crate::scene::{MaterialKind, Scene};
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+use sss_bssrdf::Rgb;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// Which integrator computes the subsurface term.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Brute-force sum over every irradiance sample of the object.
+    Exact,
+    /// BSSRDF importance sampling with probe rays (pbrt §15.4).
+    PathTrace,
+}
+
+impl Method {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Exact => "exact",
+            Method::PathTrace => "pathtrace",
+        }
+    }
+}
+
+/// Everything a render needs besides the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// The integrator.
+    pub method: Method,
+    /// Path tracer: BSSRDF samples per pixel sample.
+    pub spp: u32,
+    /// Seed of every random stream.
+    pub seed: u64,
+    /// Irradiance sample placement and lighting (point-based methods).
+    pub irradiance: IrradianceSettings,
+    /// Light samples per quad or environment light when shading opaque surfaces.
+    pub opaque_light_samples: u32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            method: Method::Exact,
+            spp: 16,
+            seed: 1,
+            irradiance: IrradianceSettings::default(),
+            opaque_light_samples: 16,
+        }
+    }
+}
+
+/// Wall-clock time of one stage.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage {
+    /// Stage name (`bvh`, `gbuffer`, `models`, `samples`, `shading`, ...).
+    pub name: &'static str,
+    /// Seconds.
+    pub seconds: f64,
+}
+
+/// The result of a render. Pixel arrays are row-major from the top-left, width·height long,
+/// linear RGB, finite and non-negative.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The subsurface term (0 off translucent objects).
+    pub subsurface: Vec<Rgb>,
+    /// Subsurface on translucent objects, direct diffuse light on opaque ones, the environment
+    /// where rays leave the scene.
+    pub total: Vec<Rgb>,
+    /// Path tracer only: the standard error of each pixel's subsurface estimate.
+    pub std_error: Option<Vec<Rgb>>,
+    /// Fraction of each pixel's camera samples that landed on a translucent object.
+    pub coverage: Vec<f32>,
+    /// Timings by stage, in order.
+    pub stages: Vec<Stage>,
+    /// Irradiance samples used, summed over objects.
+    pub irradiance_samples: usize,
+    /// Minimum spacing of the irradiance samples per object (object index, scene units).
+    pub spacing: Vec<(u32, f64)>,
+}
+
+impl RenderOutput {
+    /// Total seconds over all stages.
+    pub fn seconds_total(&self) -> f64 {
+        self.stages.iter().map(|s| s.seconds).sum()
+    }
+
+    /// Pixel indices with some translucent coverage: the pixels error figures are taken over.
+    pub fn translucent_pixels(&self) -> Vec<usize> {
+        (0..self.coverage.len()).filter(|&i| self.coverage[i] > 0.0).collect()
+    }
+}
+
+/// The parts of a render every integrator shares: geometry, G-buffer, the translucent objects
+/// seen, their shading data and (for point-based integrators) their irradiance samples.
+pub struct Prepared<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Per-object BVHs.
+    pub geom: SceneGeometry,
+    /// The camera's hits.
+    pub gbuffer: GBuffer,
+    /// Translucent objects with at least one G-buffer sample, ascending.
+    pub visible: Vec<u32>,
+    /// Shading data per material (None for materials no visible translucent object uses).
+    pub shading: Vec<Option<TranslucentShading>>,
+    /// Timings so far.
+    pub stages: Vec<Stage>,
+}
+
+fn timed<T>(stages: &mut Vec<Stage>, name: &'static str, f: impl FnOnce() -> T) -> T {
+    let t = Instant::now();
+    let v = f();
+    stages.push(Stage {
+        name,
+        seconds: t.elapsed().as_secs_f64(),
+    });
+    v
+}
+
+/// Builds the BVHs, casts the camera rays and builds the models of the translucent materials
+/// the camera sees.
+pub fn prepare<'a>(scene: &'a Scene, seed: u64) -> Prepared<'a> {
+    let mut stages = Vec::new();
+    let geom = timed(&mut stages, "bvh", || SceneGeometry::new(scene));
+    let gbuffer = timed(&mut stages, "gbuffer", || GBuffer::new(scene, &geom, seed));
+    let mut seen = vec![false; scene.objects.len()];
+    for g in &gbuffer.samples {
+        seen[g.object as usize] = true;
+    }
+    let visible: Vec<u32> = (0..scene.objects.len() as u32)
+        .filter(|&o| seen[o as usize] && scene.translucent(o as usize).is_some())
+        .collect();
+    let shading = timed(&mut stages, "models", || shading_for(scene, &visible));
+    Prepared {
+        scene,
+        geom,
+        gbuffer,
+        visible,
+        shading,
+        stages,
+    }
+}
+
+impl Prepared<'_> {
+    /// The shading data of the translucent object `object`, if it is translucent and visible.
+    pub fn shading_of(&self, object: u32) -> Option<&TranslucentShading> {
+        self.shading[self.scene.objects[object as usize].material].as_ref()
+    }
+
+    /// Places and lights the irradiance samples of the visible translucent objects.
+    pub fn irradiance_samples(&mut self, settings: &IrradianceSettings, seed: u64) -> Vec<ObjectSamples> {
+        let (scene, geom, visible) = (self.scene, &self.geom, &self.visible);
+        timed(&mut self.stages, "samples", || {
+            irradiance::compute(scene, geom, visible, settings, seed)
+        })
+    }
+
+    /// Direct light reflected by an opaque diffuse surface at `g` towards the camera.
+    pub fn shade_opaque(&self, g: &GSample, light_samples: u32, seed: u64) -> Rgb {
+        let mat = &self.scene.materials[self.scene.objects[g.object as usize].material];
+        let MaterialKind::Diffuse { albedo, texture } = &mat.kind else {
+            return [0.0; 3];
+        };
+        let tex = texture.as_ref().map_or([1.0; 3], |t| t.eval(g.p));
+        // Light the side the camera sees.
+        let (n, ng) = if g.ng.dot(g.wo) >= 0.0 { (g.n, g.ng) } else { (-g.n, -g.ng) };
+        let idx = g.pixel as u64 * self.gbuffer.samples_per_pixel as u64 + g.index as u64;
+        let mut r = rng(seed, Stream::Opaque, idx);
+        let mut packets = Vec::new();
+        gather(&self.geom, &self.scene.lights, g.p, n, ng, light_samples, &mut r, &mut packets);
+        let mut out = [0.0; 3];
+        for p in &packets {
+            for c in 0..3 {
+                out[c] += albedo[c] * tex[c] / PI * p.e_cos[c];
+            }
+        }
+        out
+    }
+
+    /// Assembles the output from per-pixel-sample subsurface values (indexed like
+    /// `gbuffer.samples`; `None` for samples not on a visible translucent object), shading
+    /// opaque samples and adding the background.
+    pub fn assemble(
+        &mut self,
+        subsurface: &[Rgb],
+        std_error: Option<Vec<Rgb>>,
+        settings: &RenderSettings,
+        irradiance_samples: usize,
+        spacing: Vec<(u32, f64)>,
+    ) -> RenderOutput {
+        let gb = &self.gbuffer;
+        let spp = gb.samples_per_pixel as f64;
+        let bg = background(&self.scene.lights);
+        let this = &*self;
+        let t = Instant::now();
+        let pixels: Vec<(Rgb, Rgb, f32)> = (0..gb.pixels())
+            .into_par_iter()
+            .map(|i| {
+                let (lo, hi) = (gb.offsets[i] as usize, gb.offsets[i + 1] as usize);
+                let mut sss = [0.0; 3];
+                let mut total = [0.0; 3];
+                let mut covered = 0u32;
+                for k in lo..hi {
+                    let g = &gb.samples[k];
+                    let v = if this.shading_of(g.object).is_some() {
+                        covered += 1;
+                        subsurface[k]
+                    } else {
+                        this.shade_opaque(g, settings.opaque_light_samples, settings.seed)
+                    };
+                    for c in 0..3 {
+                        let v = if v[c].is_finite() && v[c] > 0.0 { v[c] } else { 0.0 };
+                        total[c] += v / spp;
+                        if this.shading_of(g.object).is_some() {
+                            sss[c] += v / spp;
+                        }
+                    }
+                }
+                let misses = (gb.samples_per_pixel as usize).saturating_sub(hi - lo) as f64;
+                for c in 0..3 {
+                    total[c] += bg[c] * misses / spp;
+                }
+                (sss, total, covered as f32 / spp as f32)
+            })
+            .collect();
+        let opaque_seconds = t.elapsed().as_secs_f64();
+        self.stages.push(Stage {
+            name: "opaque",
+            seconds: opaque_seconds,
+        });
+        RenderOutput {
+            width: gb.width,
+            height: gb.height,
+            subsurface: pixels.iter().map(|p| p.0).collect(),
+            total: pixels.iter().map(|p| p.1).collect(),
+            std_error,
+            coverage: pixels.iter().map(|p| p.2).collect(),
+            stages: self.stages.clone(),
+            irradiance_samples,
+            spacing,
+        }
+    }
+}
+
+/// Renders `scene` with `settings`. `progress`, if given, counts shaded pixel samples.
+pub fn render(scene: &Scene, settings: &RenderSettings, progress: Option<&ProgressBar>) -> RenderOutput {
+    let mut prep = prepare(scene, settings.seed);
+    let n = prep.gbuffer.samples.len();
+    if let Some(p) = progress {
+        p.set_length(n as u64);
+    }
+    match settings.method {
+        Method::Exact => {
+            let samples = prep.irradiance_samples(&settings.irradiance, settings.seed);
+            let count = samples.iter().map(|s| s.samples.len()).sum();
+            let spacing = samples.iter().map(|s| (s.object, s.spacing)).collect();
+            let t = Instant::now();
+            let by_object: Vec<Option<&ObjectSamples>> = (0..scene.objects.len() as u32)
+                .map(|o| samples.iter().find(|s| s.object == o))
+                .collect();
+            let values: Vec<Rgb> = prep
+                .gbuffer
+                .samples
+                .par_iter()
+                .map(|g| {
+                    let v = match (prep.shading_of(g.object), by_object[g.object as usize]) {
+                        (Some(sh), Some(s)) => exact::shade(g, sh, s),
+                        _ => [0.0; 3],
+                    };
+                    if let Some(p) = progress {
+                        p.inc(1);
+                    }
+                    v
+                })
+                .collect();
+            prep.stages.push(Stage {
+                name: "shading",
+                seconds: t.elapsed().as_secs_f64(),
+            });
+            prep.assemble(&values, None, settings, count, spacing)
+        }
+        Method::PathTrace => {
+            let t = Instant::now();
+            let radii: Vec<Option<ProbeRadii>> = prep
+                .shading
+                .iter()
+                .map(|s| s.as_ref().map(ProbeRadii::new))
+                .collect();
+            let spp = settings.spp.max(1);
+            let gspp = prep.gbuffer.samples_per_pixel as u64;
+            let results: Vec<(Rgb, Rgb)> = prep
+                .gbuffer
+                .samples
+                .par_iter()
+                .map_init(
+                    || (Vec::new(), Vec::new(), Vec::new()),
+                    |(hits, scratch, packets), g| {
+                        let m = scene.objects[g.object as usize].material;
+                        let (Some(sh), Some(rad)) = (prep.shading[m].as_ref(), radii[m].as_ref()) else {
+                            return ([0.0; 3], [0.0; 3]);
+                        };
+                        let mut r = rng(settings.seed, Stream::Path, g.pixel as u64 * gspp + g.index as u64);
+                        let mut sum = [0.0; 3];
+                        let mut sum2 = [0.0; 3];
+                        for _ in 0..spp {
+                            let v = pathtrace::sample(&prep.geom, &scene.lights, g, sh, rad, &mut r, hits, scratch, packets);
+                            for c in 0..3 {
+                                sum[c] += v[c];
+                                sum2[c] += v[c] * v[c];
+                            }
+                        }
+                        if let Some(p) = progress {
+                            p.inc(1);
+                        }
+                        let k = spp as f64;
+                        let mean = sum.map(|s| s / k);
+                        // Variance of the mean of this sample's spp estimates.
+                        let var = [0, 1, 2].map(|c| {
+                            if spp > 1 {
+                                ((sum2[c] - k * mean[c] * mean[c]) / (k - 1.0)).max(0.0) / k
+                            } else {
+                                0.0
+                            }
+                        });
+                        (mean, var)
+                    },
+                )
+                .collect();
+            prep.stages.push(Stage {
+                name: "shading",
+                seconds: t.elapsed().as_secs_f64(),
+            });
+            let values: Vec<Rgb> = results.iter().map(|r| r.0).collect();
+            // Pixel standard error: the pixel averages its samples (1/spp_camera each).
+            let gb = &prep.gbuffer;
+            let cs = gb.samples_per_pixel as f64;
+            let se: Vec<Rgb> = (0..gb.pixels())
+                .map(|i| {
+                    let mut v = [0.0; 3];
+                    for k in gb.offsets[i] as usize..gb.offsets[i + 1] as usize {
+                        for c in 0..3 {
+                            v[c] += results[k].1[c] / (cs * cs);
+                        }
+                    }
+                    v.map(|x| x.sqrt())
+                })
+                .collect();
+            prep.assemble(&values, Some(se), settings, 0, Vec::new())
+        }
+    }
+}

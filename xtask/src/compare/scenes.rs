@@ -1,0 +1,485 @@
+//! The rendering experiment: every registered [`SceneMethod`] over its parameter sweep on the
+//! default scenes (and any named ones), against a cached `exact` reference per scene.
+//!
+//! Writes `results.csv` (one row per run and thread count; columns documented in README.md),
+//! `error_vs_time_<scene>.png` (log-log RMSE against total seconds), and under
+//! `scenes/<scene>/` the reference, each method's most expensive render and its false-colour
+//! error map.
+
+use super::output::{csv_num, md_num, md_pct, md_table, write_atomic};
+use super::{Context, Error, Experiment, Section};
+use sss_render::image::{read_exr, write_error_map, write_exr, write_png, auto_exposure};
+use sss_render::irradiance::IrradianceSettings;
+use sss_render::plot::{Series, SeriesStyle, line_plot};
+use sss_render::render::{Method, RenderOutput, RenderSettings, Stage, render};
+use sss_render::render_cli::{error_figures, relative_errors};
+use sss_render::scene::{self, LoadOptions, Scene, SceneErrorKind};
+use sss_bssrdf::Rgb;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Relative-error threshold of `frac_within_eps`.
+pub const EPS: f64 = 0.05;
+
+/// Bumped whenever the reference renderer's output changes, to invalidate cached references.
+const REFERENCE_VERSION: u32 = 1;
+
+/// Stage columns of `results.csv`, in order. Methods report a subset; the rest stay empty.
+pub const STAGES: [&str; 6] = ["bvh", "gbuffer", "models", "samples", "shading", "opaque"];
+
+/// A rendering method with a one-parameter sweep.
+pub trait SceneMethod {
+    /// Name in reports (`exact`, `pathtrace`, ...).
+    fn name(&self) -> &'static str;
+    /// The swept parameter's name.
+    fn param(&self) -> &'static str;
+    /// Parameter values, cheapest first.
+    fn values(&self, quick: bool) -> Vec<f64>;
+    /// Renders `scene` with the parameter at `value`.
+    fn run(&self, scene: &Scene, value: f64, seed: u64) -> RenderOutput;
+}
+
+/// The reference settings: exact at the default spacing.
+fn reference_settings(seed: u64) -> RenderSettings {
+    RenderSettings {
+        method: Method::Exact,
+        seed,
+        ..RenderSettings::default()
+    }
+}
+
+/// `exact` with coarser irradiance samples: how error grows as the samples thin out.
+struct ExactSpacing;
+
+impl SceneMethod for ExactSpacing {
+    fn name(&self) -> &'static str {
+        "exact"
+    }
+    fn param(&self) -> &'static str {
+        "spacing_mfp"
+    }
+    fn values(&self, _quick: bool) -> Vec<f64> {
+        vec![4.0, 2.0, 1.0]
+    }
+    fn run(&self, scene: &Scene, value: f64, seed: u64) -> RenderOutput {
+        let s = RenderSettings {
+            irradiance: IrradianceSettings {
+                spacing_mfp: value,
+                ..IrradianceSettings::default()
+            },
+            ..reference_settings(seed)
+        };
+        render(scene, &s, None)
+    }
+}
+
+/// The BSSRDF-importance-sampled path tracer at growing sample counts.
+struct PathTrace;
+
+impl SceneMethod for PathTrace {
+    fn name(&self) -> &'static str {
+        "pathtrace"
+    }
+    fn param(&self) -> &'static str {
+        "spp"
+    }
+    fn values(&self, quick: bool) -> Vec<f64> {
+        if quick { vec![1.0, 4.0, 16.0] } else { vec![1.0, 4.0, 16.0, 64.0] }
+    }
+    fn run(&self, scene: &Scene, value: f64, seed: u64) -> RenderOutput {
+        let s = RenderSettings {
+            method: Method::PathTrace,
+            spp: value as u32,
+            ..reference_settings(seed)
+        };
+        render(scene, &s, None)
+    }
+}
+
+/// Every registered rendering method (later issues add theirs here).
+pub fn methods() -> Vec<Box<dyn SceneMethod>> {
+    vec![Box::new(ExactSpacing), Box::new(PathTrace)]
+}
+
+/// One run: a method at one parameter value with one thread count.
+struct Run {
+    scene: String,
+    method: &'static str,
+    param: &'static str,
+    value: f64,
+    threads: usize,
+    stages: Vec<Stage>,
+    rmse: f64,
+    rel_rmse: f64,
+    frac_within_eps: f64,
+    /// Path tracer only: fraction of pixels within 3 standard errors of the reference.
+    within_3se: Option<f64>,
+}
+
+impl Run {
+    fn seconds_total(&self) -> f64 {
+        self.stages.iter().map(|s| s.seconds).sum()
+    }
+    fn stage(&self, name: &str) -> Option<f64> {
+        let v: Vec<f64> = self.stages.iter().filter(|s| s.name == name).map(|s| s.seconds).collect();
+        (!v.is_empty()).then(|| v.iter().sum())
+    }
+}
+
+/// The header of `results.csv` (documented in README.md).
+pub fn csv_header() -> String {
+    let mut h = String::from("scene,method,param,value,threads,seconds_total");
+    for s in STAGES {
+        let _ = write!(h, ",seconds_{s}");
+    }
+    h.push_str(",rmse,rel_rmse,frac_within_eps,frac_within_3se\n");
+    h
+}
+
+fn csv_rows(runs: &[Run]) -> String {
+    let mut s = csv_header();
+    for r in runs {
+        let _ = write!(
+            s,
+            "{},{},{},{},{},{}",
+            r.scene,
+            r.method,
+            r.param,
+            csv_num(Some(r.value)),
+            r.threads,
+            csv_num(Some(r.seconds_total()))
+        );
+        for st in STAGES {
+            let _ = write!(s, ",{}", csv_num(r.stage(st)));
+        }
+        let _ = writeln!(
+            s,
+            ",{},{},{},{}",
+            csv_num(Some(r.rmse)),
+            csv_num(Some(r.rel_rmse)),
+            csv_num(Some(r.frac_within_eps)),
+            csv_num(r.within_3se)
+        );
+    }
+    s
+}
+
+/// The scenes of a run: names of built-in scenes or paths to scene files. Scenes whose mesh is
+/// missing are skipped with a message.
+fn load_scenes(ctx: &Context<'_>) -> Result<(Vec<(Scene, String)>, Vec<String>), Error> {
+    let cfg = ctx.config;
+    let opts = LoadOptions {
+        mesh_dirs: cfg.mesh_dirs.clone(),
+    };
+    let mut out = Vec::new();
+    let mut skipped = Vec::new();
+    for name in &cfg.scenes {
+        let path = Path::new(name);
+        let (loaded, text) = if !path.exists() && scene::BUILTIN_SCENES.iter().any(|(n, _)| n == name) {
+            let text = scene::BUILTIN_SCENES.iter().find(|(n, _)| n == name).map(|(_, t)| t.to_string()).unwrap_or_default();
+            (scene::builtin(name, &opts), text)
+        } else {
+            let text = std::fs::read_to_string(path).unwrap_or_default();
+            (scene::load(path, &opts), text)
+        };
+        match loaded {
+            Ok(mut s) => {
+                if cfg.quick {
+                    // Half resolution: a quarter of the pixels.
+                    s.camera.width = (s.camera.width / 2).max(1);
+                    s.camera.height = (s.camera.height / 2).max(1);
+                }
+                out.push((s, text));
+            }
+            Err(e) if e.kind == SceneErrorKind::MeshNotFound => {
+                (ctx.log)(&format!("scene {name}: skipped ({e})"));
+                skipped.push(format!("`{name}`: {e}"));
+            }
+            Err(e) => return Err(Error(format!("scene {name}: {e}"))),
+        }
+    }
+    Ok((out, skipped))
+}
+
+/// FNV-1a over bytes: a stable cache key.
+fn fnv(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= *b as u64;
+        h = h.wrapping_mul(0x100_0000_01b3);
+    }
+    h
+}
+
+/// The cached reference of a scene: its subsurface image, coverage and timing.
+struct Reference {
+    subsurface: Vec<Rgb>,
+    total: Vec<Rgb>,
+    coverage: Vec<f32>,
+    seconds: f64,
+    samples: usize,
+}
+
+fn reference(ctx: &Context<'_>, scene: &Scene, text: &str) -> Result<Reference, Error> {
+    let cfg = ctx.config;
+    let key = fnv(
+        format!(
+            "v{REFERENCE_VERSION}|{text}|{}x{}|{}|{:?}",
+            scene.camera.width,
+            scene.camera.height,
+            cfg.seed,
+            reference_settings(cfg.seed)
+        )
+        .as_bytes(),
+    );
+    let dir = cfg.out.join("cache");
+    std::fs::create_dir_all(&dir).map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
+    let path = dir.join(format!("scene_{}_{key:016x}.exr", scene.name));
+    let meta = path.with_extension("txt");
+    if !cfg.fresh
+        && let (Ok((w, h, layers)), Ok(m)) = (read_exr(&path), std::fs::read_to_string(&meta))
+        && (w, h) == (scene.camera.width, scene.camera.height)
+    {
+        let get = |n: &str| layers.iter().find(|(name, _)| name == n).map(|(_, d)| d.clone());
+        let mut it = m.split_whitespace();
+        let seconds = it.next().and_then(|v| v.parse().ok());
+        let samples = it.next().and_then(|v| v.parse().ok());
+        if let (Some(sub), Some(tot), Some(cov), Some(seconds), Some(samples)) =
+            (get("subsurface"), get("total"), get("coverage"), seconds, samples)
+        {
+            (ctx.log)(&format!("scene {}: reference from cache", scene.name));
+            return Ok(Reference {
+                subsurface: sub,
+                total: tot,
+                coverage: cov.iter().map(|c| c[0] as f32).collect(),
+                seconds,
+                samples,
+            });
+        }
+    }
+    (ctx.log)(&format!("scene {}: rendering the exact reference", scene.name));
+    let out = render(scene, &reference_settings(cfg.seed), None);
+    let cov: Vec<Rgb> = out.coverage.iter().map(|&c| [c as f64; 3]).collect();
+    write_exr(
+        &path,
+        out.width,
+        out.height,
+        &[("subsurface", &out.subsurface), ("total", &out.total), ("coverage", &cov)],
+    )
+    .map_err(|e| Error(e.to_string()))?;
+    write_atomic(&meta, format!("{} {}\n", out.seconds_total(), out.irradiance_samples).as_bytes())?;
+    Ok(Reference {
+        subsurface: out.subsurface,
+        total: out.total,
+        coverage: out.coverage,
+        seconds: out.seconds_total(),
+        samples: out.irradiance_samples,
+    })
+}
+
+fn run_timed(method: &dyn SceneMethod, scene: &Scene, value: f64, seed: u64, threads: usize) -> Result<RenderOutput, Error> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error(format!("cannot start {threads} threads: {e}")))?;
+    Ok(pool.install(|| method.run(scene, value, seed)))
+}
+
+fn within_3se(out: &RenderOutput, reference: &[Rgb], pixels: &[usize]) -> Option<f64> {
+    let se = out.std_error.as_ref()?;
+    if pixels.is_empty() {
+        return None;
+    }
+    let ok = pixels
+        .iter()
+        .filter(|&&i| {
+            (0..3).all(|c| {
+                let d = (out.subsurface[i][c] - reference[i][c]).abs();
+                d <= 3.0 * se[i][c] + 1e-12 * reference[i][c].abs()
+            })
+        })
+        .count();
+    Some(ok as f64 / pixels.len() as f64)
+}
+
+fn write_images(dir: &Path, name: &str, out: &RenderOutput, reference: &[Rgb], pixels: &[usize], exposure: f64) -> Result<(), Error> {
+    let e = |e: sss_render::Error| Error(e.to_string());
+    write_png(&dir.join(format!("{name}.png")), out.width, out.height, &out.subsurface, exposure).map_err(e)?;
+    let rel = relative_errors(&out.subsurface, reference, pixels);
+    let mut values = vec![None; out.subsurface.len()];
+    for (k, &i) in pixels.iter().enumerate() {
+        values[i] = Some(rel[k]);
+    }
+    write_error_map(
+        &dir.join(format!("{name}_error.png")),
+        out.width,
+        out.height,
+        &values,
+        4.0 * EPS,
+        &format!("{name}: relative error against exact"),
+        "|a-ref|/ref",
+    )
+    .map_err(e)
+}
+
+/// The rendering experiment.
+pub struct SceneComparison;
+
+impl Experiment for SceneComparison {
+    fn name(&self) -> &'static str {
+        "scenes"
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Section, Error> {
+        let cfg = ctx.config;
+        let (scenes, skipped) = load_scenes(ctx)?;
+        let all_threads = rayon::current_num_threads();
+        let mut thread_counts = vec![all_threads];
+        if all_threads > 1 {
+            thread_counts.push(1);
+        }
+        let methods = methods();
+        let mut runs: Vec<Run> = Vec::new();
+        let mut body = String::new();
+        let mut summary_rows = Vec::new();
+        for (scene, text) in &scenes {
+            let reference = reference(ctx, scene, text)?;
+            let pixels: Vec<usize> = (0..reference.coverage.len()).filter(|&i| reference.coverage[i] > 0.0).collect();
+            let dir = cfg.out.join("scenes").join(&scene.name);
+            std::fs::create_dir_all(&dir).map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
+            let exposure = auto_exposure(&reference.subsurface);
+            let e = |e: sss_render::Error| Error(e.to_string());
+            write_png(&dir.join("reference.png"), scene.camera.width, scene.camera.height, &reference.subsurface, exposure).map_err(e)?;
+            write_png(&dir.join("reference_total.png"), scene.camera.width, scene.camera.height, &reference.total, auto_exposure(&reference.total)).map_err(e)?;
+            let mut series = Vec::new();
+            for (mi, m) in methods.iter().enumerate() {
+                let values = m.values(cfg.quick);
+                let mut points = Vec::new();
+                for (vi, &v) in values.iter().enumerate() {
+                    for &threads in &thread_counts {
+                        (ctx.log)(&format!("scene {}: {} {}={} ({} thread(s))", scene.name, m.name(), m.param(), v, threads));
+                        let out = run_timed(m.as_ref(), scene, v, cfg.seed, threads)?;
+                        let f = error_figures(&out.subsurface, &reference.subsurface, &pixels, EPS);
+                        let run = Run {
+                            scene: scene.name.clone(),
+                            method: m.name(),
+                            param: m.param(),
+                            value: v,
+                            threads,
+                            stages: out.stages.clone(),
+                            rmse: f.rmse,
+                            rel_rmse: f.rel_rmse,
+                            frac_within_eps: f.frac_within_eps,
+                            within_3se: within_3se(&out, &reference.subsurface, &pixels),
+                        };
+                        if threads == all_threads {
+                            points.push((run.seconds_total(), run.rmse));
+                            if vi + 1 == values.len() {
+                                write_images(&dir, &format!("{}_{}", m.name(), v), &out, &reference.subsurface, &pixels, exposure)?;
+                            }
+                        }
+                        runs.push(run);
+                    }
+                }
+                series.push(
+                    Series::line(m.name(), points)
+                        .with_style(SeriesStyle::LineMarkers)
+                        .with_color(sss_render::plot::PALETTE[(mi + 1) % 8]),
+                );
+            }
+            let plot = cfg.out.join(format!("error_vs_time_{}.png", scene.name));
+            line_plot(&plot, &format!("{}: RMSE against exact vs. time ({} threads)", scene.name, all_threads), "seconds (total)", "RMSE", &series, true, true)
+                .map_err(|e| Error(e.to_string()))?;
+            // Per-scene table.
+            let _ = writeln!(
+                body,
+                "### {}\n\n{}x{} pixels, {} translucent; reference `exact` with {} irradiance samples took {} s ({} threads). \
+                 Images in `scenes/{}/`, curve in `error_vs_time_{}.png`.\n",
+                scene.name,
+                scene.camera.width,
+                scene.camera.height,
+                pixels.len(),
+                reference.samples,
+                md_num(Some(reference.seconds), 3),
+                all_threads,
+                scene.name,
+                scene.name
+            );
+            let rows: Vec<Vec<String>> = runs
+                .iter()
+                .filter(|r| r.scene == scene.name)
+                .map(|r| {
+                    vec![
+                        r.method.to_string(),
+                        format!("{}={}", r.param, r.value),
+                        r.threads.to_string(),
+                        md_num(Some(r.seconds_total()), 3),
+                        md_num(r.stage("shading"), 3),
+                        md_num(Some(r.rmse), 3),
+                        md_pct(Some(r.rel_rmse)),
+                        md_pct(Some(r.frac_within_eps)),
+                        md_pct(r.within_3se),
+                    ]
+                })
+                .collect();
+            body.push_str(&md_table(
+                &["method", "param", "threads", "total s", "shading s", "RMSE", "rel. RMSE", &format!("within {} %", EPS * 100.0), "within 3 SE"],
+                &rows,
+            ));
+            body.push('\n');
+            let best_pt = runs
+                .iter()
+                .filter(|r| r.scene == scene.name && r.method == "pathtrace" && r.threads == all_threads)
+                .last();
+            summary_rows.push(vec![
+                scene.name.clone(),
+                pixels.len().to_string(),
+                reference.samples.to_string(),
+                md_num(Some(reference.seconds), 3),
+                best_pt.map_or("–".into(), |r| format!("{} spp: {} s", r.value, md_num(Some(r.seconds_total()), 3))),
+                best_pt.map_or("–".into(), |r| md_pct(Some(r.rel_rmse))),
+                best_pt.map_or("–".into(), |r| md_pct(r.within_3se)),
+            ]);
+        }
+        write_atomic(&cfg.out.join("results.csv"), csv_rows(&runs).as_bytes())?;
+        let mut summary = md_table(
+            &["scene", "translucent pixels", "irradiance samples", "exact s", "pathtrace", "pathtrace rel. RMSE vs exact", "pathtrace pixels within 3 SE"],
+            &summary_rows,
+        );
+        for s in &skipped {
+            let _ = writeln!(summary, "\nSkipped {s}");
+        }
+        let _ = writeln!(
+            summary,
+            "\nEvery run's figures (all threads and one thread) are in `results.csv`; error is over \
+             pixels covered by translucent objects, against the cached `exact` reference."
+        );
+        Ok(Section {
+            title: "Scenes: references and error against run time".into(),
+            summary,
+            body,
+        })
+    }
+}
+
+/// Default mesh directories: `SSS_MESH_DIR` and the shared meshes next to the workspace.
+pub fn default_mesh_dirs(workspace: &Path) -> Vec<PathBuf> {
+    let mut dirs = LoadOptions::from_env().mesh_dirs;
+    if let Some(parent) = workspace.parent() {
+        dirs.push(parent.join("shared").join("meshes"));
+    }
+    dirs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_header_has_the_documented_columns() {
+        let h = csv_header();
+        for col in ["scene", "method", "param", "value", "threads", "seconds_total", "seconds_shading", "rmse", "rel_rmse", "frac_within_eps"] {
+            assert!(h.split(',').any(|c| c.trim() == col), "{col} missing from {h}");
+        }
+    }
+}
