@@ -115,7 +115,13 @@ impl SceneGeometry {
         &self.objects[object as usize].mesh
     }
 
-    fn surface_hit(&self, object: u32, hit: sss_hierarchy::Hit, origin: DVec3, dir: DVec3) -> SurfaceHit {
+    fn surface_hit(
+        &self,
+        object: u32,
+        hit: sss_hierarchy::Hit,
+        origin: DVec3,
+        dir: DVec3,
+    ) -> SurfaceHit {
         let mesh = &self.objects[object as usize].mesh;
         let [a, b, c] = mesh.triangles[hit.triangle as usize];
         let (pa, pb, pc) = (
@@ -125,7 +131,11 @@ impl SceneGeometry {
         );
         let w = 1.0 - hit.u - hit.v;
         let p_bary = pa * w + pb * hit.u + pc * hit.v;
-        let p = if p_bary.is_finite() { p_bary } else { origin + dir * hit.t };
+        let p = if p_bary.is_finite() {
+            p_bary
+        } else {
+            origin + dir * hit.t
+        };
         let ng = (pb - pa).cross(pc - pa).normalize_or_zero();
         let ns = (mesh.normals[a as usize] * w
             + mesh.normals[b as usize] * hit.u
@@ -143,7 +153,13 @@ impl SceneGeometry {
     }
 
     /// The closest surface along the ray with t in (t_min, t_max), over all objects.
-    pub fn closest_hit(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> Option<SurfaceHit> {
+    pub fn closest_hit(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        t_max: f64,
+    ) -> Option<SurfaceHit> {
         let mut best: Option<(u32, sss_hierarchy::Hit)> = None;
         let mut t_best = t_max;
         for (i, o) in self.objects.iter().enumerate() {
@@ -179,7 +195,8 @@ impl SceneGeometry {
     /// Whether anything blocks the segment (t_min, t_max) of the ray.
     pub fn occluded(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> bool {
         self.objects.iter().any(|o| {
-            ray_box(o.lo, o.hi, origin, dir, t_min, t_max) && o.bvh.occluded(origin, dir, t_min, t_max)
+            ray_box(o.lo, o.hi, origin, dir, t_min, t_max)
+                && o.bvh.occluded(origin, dir, t_min, t_max)
         })
     }
 

@@ -45,7 +45,11 @@ fn finish(tmp: &Path, path: &Path, result: Result<(), Error>) -> Result<(), Erro
 /// Non-finite or negative values become 0 in every written image.
 #[inline]
 fn clean(v: f64) -> f32 {
-    if v.is_finite() && v > 0.0 { v as f32 } else { 0.0 }
+    if v.is_finite() && v > 0.0 {
+        v as f32
+    } else {
+        0.0
+    }
 }
 
 /// Writes a linear OpenEXR file with one RGB f32 layer per `(name, pixels)` (row-major,
@@ -83,13 +87,22 @@ pub fn write_exr(
             )
         })
         .collect();
-    let image = Image::from_layers(ImageAttributes::new(IntegerBounds::from_dimensions(size)), layers);
-    let result = image.write().to_file(&tmp).map_err(|e| io_err(path, "writing", e));
+    let image = Image::from_layers(
+        ImageAttributes::new(IntegerBounds::from_dimensions(size)),
+        layers,
+    );
+    let result = image
+        .write()
+        .to_file(&tmp)
+        .map_err(|e| io_err(path, "writing", e));
     finish(&tmp, path, result)
 }
 
-/// Reads every RGB layer of an OpenEXR file as (layer name, pixels), with the image size.
-pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<(String, Vec<Rgb>)>), crate::Error> {
+/// Named RGB layers of an image: (layer name, pixels).
+pub type Layers = Vec<(String, Vec<Rgb>)>;
+
+/// Reads every RGB layer of an OpenEXR file, with the image size (width, height).
+pub fn read_exr(path: &Path) -> Result<(u32, u32, Layers), crate::Error> {
     use exr::prelude::*;
     let image = read()
         .no_deep_data()
@@ -129,14 +142,21 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<(String, Vec<Rgb>)>), crat
         }
     }
     if out.is_empty() {
-        return Err(crate::Error::Input(format!("{}: no RGB layer", path.display())));
+        return Err(crate::Error::Input(format!(
+            "{}: no RGB layer",
+            path.display()
+        )));
     }
     Ok((size.0, size.1, out))
 }
 
 /// Linear → sRGB transfer (IEC 61966-2-1), for values in [0, 1].
 fn srgb(v: f64) -> u8 {
-    let v = if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
+    let v = if v.is_finite() {
+        v.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let s = if v <= 0.003_130_8 {
         12.92 * v
     } else {
@@ -162,10 +182,22 @@ pub fn auto_exposure(pixels: &[Rgb]) -> f64 {
 }
 
 /// Writes `pixels` × `exposure` as an 8-bit sRGB PNG (values clipped to [0, 1]).
-pub fn write_png(path: &Path, width: u32, height: u32, pixels: &[Rgb], exposure: f64) -> Result<(), Error> {
+pub fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Rgb],
+    exposure: f64,
+) -> Result<(), Error> {
     let bytes: Vec<u8> = pixels
         .iter()
-        .flat_map(|p| [srgb(p[0] * exposure), srgb(p[1] * exposure), srgb(p[2] * exposure)])
+        .flat_map(|p| {
+            [
+                srgb(p[0] * exposure),
+                srgb(p[1] * exposure),
+                srgb(p[2] * exposure),
+            ]
+        })
         .collect();
     write_png_rgb8(path, width, height, &bytes)
 }
@@ -173,7 +205,10 @@ pub fn write_png(path: &Path, width: u32, height: u32, pixels: &[Rgb], exposure:
 /// Writes raw 8-bit RGB bytes as a PNG.
 pub fn write_png_rgb8(path: &Path, width: u32, height: u32, bytes: &[u8]) -> Result<(), Error> {
     if bytes.len() != width as usize * height as usize * 3 {
-        return Err(Error::Input(format!("{}: wrong pixel count", path.display())));
+        return Err(Error::Input(format!(
+            "{}: wrong pixel count",
+            path.display()
+        )));
     }
     let tmp = temp_path(path);
     let result = (|| {
@@ -201,7 +236,11 @@ pub fn false_colour(t: f64) -> [u8; 3] {
         [252.0, 165.0, 10.0],
         [252.0, 255.0, 164.0],
     ];
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let x = t * 5.0;
     let i = (x.floor() as usize).min(4);
     let f = x - i as f64;
@@ -224,10 +263,17 @@ pub fn write_error_map(
     label: &str,
 ) -> Result<(), Error> {
     if values.len() != width as usize * height as usize {
-        return Err(Error::Input(format!("{}: wrong pixel count", path.display())));
+        return Err(Error::Input(format!(
+            "{}: wrong pixel count",
+            path.display()
+        )));
     }
     crate::plot::check_writable(path)?;
-    let max = if max.is_finite() && max > 0.0 { max } else { 1.0 };
+    let max = if max.is_finite() && max > 0.0 {
+        max
+    } else {
+        1.0
+    };
     let scale = (512 / width.max(height)).clamp(1, 8);
     let (iw, ih) = (width * scale, height * scale);
     let (bar_w, margin, title_h) = (150u32, 10u32, 30u32);
@@ -237,8 +283,12 @@ pub fn write_error_map(
         crate::plot::ensure_font().map_err(|e| e.to_string())?;
         let root = BitMapBackend::new(&tmp, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        root.draw_text(title, &("sans-serif", 18).into_text_style(&root), (margin as i32, 5))
-            .map_err(|e| e.to_string())?;
+        root.draw_text(
+            title,
+            &("sans-serif", 18).into_text_style(&root),
+            (margin as i32, 5),
+        )
+        .map_err(|e| e.to_string())?;
         let (ox, oy) = (margin as i32, (title_h + margin) as i32);
         for y in 0..height {
             for x in 0..width {

@@ -9,7 +9,7 @@
 //! sample also keeps its incident light packets.
 
 use crate::geometry::{SceneGeometry, triangles_of};
-use crate::lights::{Incident, gather};
+use crate::lights::{Incident, Receiver, gather};
 use crate::rng::{Stream, rng};
 use crate::scene::Scene;
 use glam::DVec3;
@@ -98,7 +98,8 @@ pub fn compute(
             let spacing = settings.spacing_mfp * mfp_mm * mat.units_per_mm;
             let mesh = geom.mesh(o);
             let tris = triangles_of(mesh);
-            let place_seed = crate::rng::mix64(seed ^ crate::rng::mix64(Stream::Placement as u64 + o as u64));
+            let place_seed =
+                crate::rng::mix64(seed ^ crate::rng::mix64(Stream::Placement as u64 + o as u64));
             let (points, stats) =
                 sss_hierarchy::blue_noise_on_mesh(&tris, spacing, settings.max_samples, place_seed);
             let directional = mat.model == ModelKind::DirectionalDipole;
@@ -121,8 +122,22 @@ pub fn compute(
                         .normalize_or(ng);
                     let mut r = rng(seed, Stream::Irradiance, ((o as u64) << 40) ^ i as u64);
                     let mut inc = Vec::new();
-                    gather(geom, &scene.lights, s.position, n, ng, settings.light_samples, &mut r, &mut inc);
-                    let tex = mat.texture.as_ref().map_or([1.0; 3], |t| t.eval(s.position));
+                    gather(
+                        geom,
+                        &scene.lights,
+                        Receiver {
+                            p: s.position,
+                            n,
+                            ng,
+                        },
+                        settings.light_samples,
+                        &mut r,
+                        &mut inc,
+                    );
+                    let tex = mat
+                        .texture
+                        .as_ref()
+                        .map_or([1.0; 3], |t| t.eval(s.position));
                     let mut e = [0.0; 3];
                     for packet in &mut inc {
                         let ft = ft_dielectric(n.dot(packet.dir), eta);

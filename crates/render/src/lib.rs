@@ -25,6 +25,11 @@
 //! 2012, Frisvad et al. 2014, Habel et al. 2013) and its Monte Carlo reference (MCML, Wang et
 //! al. 1995).
 
+// `!(x > 0.0)` is the NaN-rejecting comparison used throughout the numerical code.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Colour loops index several [f64; 3] arrays in step (`for c in 0..3`).
+#![allow(clippy::needless_range_loop)]
+
 pub mod camera;
 pub mod cli;
 mod error;
@@ -37,10 +42,10 @@ pub mod lights;
 pub mod plot;
 pub mod presets_table;
 pub mod profile;
-pub mod scene;
 pub mod progress;
 pub mod render;
 pub mod render_cli;
 pub mod rng;
+pub mod scene;
 
 pub use error::Error;

@@ -20,20 +20,30 @@ pub struct Incident {
     pub e_cos: Rgb,
 }
 
-/// Gathers the direct light at `p` (unit shading normal `n`, geometric normal `ng`) into `out`:
+/// A point on a surface where light is gathered.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Receiver {
+    /// Position.
+    pub p: DVec3,
+    /// Unit shading normal (cosines are taken against it).
+    pub n: DVec3,
+    /// Unit geometric normal (rays leave on its side).
+    pub ng: DVec3,
+}
+
+/// Gathers the direct light at receiver `at` into `out`:
 /// one packet per point or directional light that is above the surface and unblocked, and
 /// `area_samples` packets (each carrying 1/`area_samples` of the estimate) per quad or
 /// environment light. Packets with zero contribution are left out.
 pub fn gather(
     geom: &SceneGeometry,
     lights: &[Light],
-    p: DVec3,
-    n: DVec3,
-    ng: DVec3,
+    at: Receiver,
     area_samples: u32,
     rng: &mut Pcg64Mcg,
     out: &mut Vec<Incident>,
 ) {
+    let Receiver { p, n, ng } = at;
     let m = area_samples.max(1);
     let eps = geom.epsilon();
     for light in lights {

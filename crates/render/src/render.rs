@@ -7,7 +7,7 @@ use crate::geometry::SceneGeometry;
 use crate::integrators::pathtrace::{self, ProbeRadii};
 use crate::integrators::{TranslucentShading, exact, shading_for};
 use crate::irradiance::{self, IrradianceSettings, ObjectSamples};
-use crate::lights::{background, gather};
+use crate::lights::{Receiver, background, gather};
 use crate::rng::{Stream, rng};
 use crate::scene::{MaterialKind, Scene};
 use indicatif::ProgressBar;
@@ -104,7 +104,9 @@ impl RenderOutput {
 
     /// Pixel indices with some translucent coverage: the pixels error figures are taken over.
     pub fn translucent_pixels(&self) -> Vec<usize> {
-        (0..self.coverage.len()).filter(|&i| self.coverage[i] > 0.0).collect()
+        (0..self.coverage.len())
+            .filter(|&i| self.coverage[i] > 0.0)
+            .collect()
     }
 }
 
@@ -166,7 +168,11 @@ impl Prepared<'_> {
     }
 
     /// Places and lights the irradiance samples of the visible translucent objects.
-    pub fn irradiance_samples(&mut self, settings: &IrradianceSettings, seed: u64) -> Vec<ObjectSamples> {
+    pub fn irradiance_samples(
+        &mut self,
+        settings: &IrradianceSettings,
+        seed: u64,
+    ) -> Vec<ObjectSamples> {
         let (scene, geom, visible) = (self.scene, &self.geom, &self.visible);
         timed(&mut self.stages, "samples", || {
             irradiance::compute(scene, geom, visible, settings, seed)
@@ -181,11 +187,22 @@ impl Prepared<'_> {
         };
         let tex = texture.as_ref().map_or([1.0; 3], |t| t.eval(g.p));
         // Light the side the camera sees.
-        let (n, ng) = if g.ng.dot(g.wo) >= 0.0 { (g.n, g.ng) } else { (-g.n, -g.ng) };
+        let (n, ng) = if g.ng.dot(g.wo) >= 0.0 {
+            (g.n, g.ng)
+        } else {
+            (-g.n, -g.ng)
+        };
         let idx = g.pixel as u64 * self.gbuffer.samples_per_pixel as u64 + g.index as u64;
         let mut r = rng(seed, Stream::Opaque, idx);
         let mut packets = Vec::new();
-        gather(&self.geom, &self.scene.lights, g.p, n, ng, light_samples, &mut r, &mut packets);
+        gather(
+            &self.geom,
+            &self.scene.lights,
+            Receiver { p: g.p, n, ng },
+            light_samples,
+            &mut r,
+            &mut packets,
+        );
         let mut out = [0.0; 3];
         for p in &packets {
             for c in 0..3 {
@@ -227,7 +244,11 @@ impl Prepared<'_> {
                         this.shade_opaque(g, settings.opaque_light_samples, settings.seed)
                     };
                     for c in 0..3 {
-                        let v = if v[c].is_finite() && v[c] > 0.0 { v[c] } else { 0.0 };
+                        let v = if v[c].is_finite() && v[c] > 0.0 {
+                            v[c]
+                        } else {
+                            0.0
+                        };
                         total[c] += v / spp;
                         if this.shading_of(g.object).is_some() {
                             sss[c] += v / spp;
@@ -261,7 +282,11 @@ impl Prepared<'_> {
 }
 
 /// Renders `scene` with `settings`. `progress`, if given, counts shaded pixel samples.
-pub fn render(scene: &Scene, settings: &RenderSettings, progress: Option<&ProgressBar>) -> RenderOutput {
+pub fn render(
+    scene: &Scene,
+    settings: &RenderSettings,
+    progress: Option<&ProgressBar>,
+) -> RenderOutput {
     let mut prep = prepare(scene, settings.seed);
     let n = prep.gbuffer.samples.len();
     if let Some(p) = progress {
@@ -305,44 +330,52 @@ pub fn render(scene: &Scene, settings: &RenderSettings, progress: Option<&Progre
                 .map(|s| s.as_ref().map(ProbeRadii::new))
                 .collect();
             let spp = settings.spp.max(1);
+            let sampler = |shading, radii| pathtrace::Sampler {
+                geom: &prep.geom,
+                lights: &scene.lights,
+                shading,
+                radii,
+            };
             let gspp = prep.gbuffer.samples_per_pixel as u64;
             let results: Vec<(Rgb, Rgb)> = prep
                 .gbuffer
                 .samples
                 .par_iter()
-                .map_init(
-                    || (Vec::new(), Vec::new(), Vec::new()),
-                    |(hits, scratch, packets), g| {
-                        let m = scene.objects[g.object as usize].material;
-                        let (Some(sh), Some(rad)) = (prep.shading[m].as_ref(), radii[m].as_ref()) else {
-                            return ([0.0; 3], [0.0; 3]);
-                        };
-                        let mut r = rng(settings.seed, Stream::Path, g.pixel as u64 * gspp + g.index as u64);
-                        let mut sum = [0.0; 3];
-                        let mut sum2 = [0.0; 3];
-                        for _ in 0..spp {
-                            let v = pathtrace::sample(&prep.geom, &scene.lights, g, sh, rad, &mut r, hits, scratch, packets);
-                            for c in 0..3 {
-                                sum[c] += v[c];
-                                sum2[c] += v[c] * v[c];
-                            }
+                .map_init(pathtrace::Scratch::default, |scratch, g| {
+                    let m = scene.objects[g.object as usize].material;
+                    let (Some(sh), Some(rad)) = (prep.shading[m].as_ref(), radii[m].as_ref())
+                    else {
+                        return ([0.0; 3], [0.0; 3]);
+                    };
+                    let mut r = rng(
+                        settings.seed,
+                        Stream::Path,
+                        g.pixel as u64 * gspp + g.index as u64,
+                    );
+                    let mut sum = [0.0; 3];
+                    let mut sum2 = [0.0; 3];
+                    for _ in 0..spp {
+                        let v = sampler(sh, rad).sample(g, &mut r, scratch);
+                        for c in 0..3 {
+                            sum[c] += v[c];
+                            sum2[c] += v[c] * v[c];
                         }
-                        if let Some(p) = progress {
-                            p.inc(1);
+                    }
+                    if let Some(p) = progress {
+                        p.inc(1);
+                    }
+                    let k = spp as f64;
+                    let mean = sum.map(|s| s / k);
+                    // Variance of the mean of this sample's spp estimates.
+                    let var = [0, 1, 2].map(|c| {
+                        if spp > 1 {
+                            ((sum2[c] - k * mean[c] * mean[c]) / (k - 1.0)).max(0.0) / k
+                        } else {
+                            0.0
                         }
-                        let k = spp as f64;
-                        let mean = sum.map(|s| s / k);
-                        // Variance of the mean of this sample's spp estimates.
-                        let var = [0, 1, 2].map(|c| {
-                            if spp > 1 {
-                                ((sum2[c] - k * mean[c] * mean[c]) / (k - 1.0)).max(0.0) / k
-                            } else {
-                                0.0
-                            }
-                        });
-                        (mean, var)
-                    },
-                )
+                    });
+                    (mean, var)
+                })
                 .collect();
             prep.stages.push(Stage {
                 name: "shading",

@@ -108,7 +108,10 @@ fn check_output(path: &Path, ext: &str) -> Result<(), Error> {
 /// Runs `sss render`: returns the text for stdout (a summary and the timing breakdown).
 pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
     if !(args.spacing.is_finite() && args.spacing > 0.0) {
-        return Err(Error::Input(format!("--spacing must be positive, got {}", args.spacing)));
+        return Err(Error::Input(format!(
+            "--spacing must be positive, got {}",
+            args.spacing
+        )));
     }
     if args.spp == 0 {
         return Err(Error::Input("--spp must be at least 1".into()));
@@ -143,22 +146,39 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()
-        .map_err(|e| Error::Input(format!("cannot start {} threads: {e}", args.threads.unwrap_or(0))))?;
+        .map_err(|e| {
+            Error::Input(format!(
+                "cannot start {} threads: {e}",
+                args.threads.unwrap_or(0)
+            ))
+        })?;
     let bar = progress::bar(0, "pixel samples");
     let out = pool.install(|| render(&scene, &settings, Some(&bar)));
     bar.finish_and_clear();
     let write_t = std::time::Instant::now();
     if let Some(p) = &args.out {
-        let mut layers: Vec<(&str, &[Rgb])> = vec![("total", &out.total), ("subsurface", &out.subsurface)];
+        let mut layers: Vec<(&str, &[Rgb])> =
+            vec![("total", &out.total), ("subsurface", &out.subsurface)];
         if let Some(se) = &out.std_error {
             layers.push(("std_error", se));
         }
         write_exr(p, out.width, out.height, &layers)?;
     }
     if let Some(p) = &args.png {
-        write_png(p, out.width, out.height, &out.total, auto_exposure(&out.total))?;
+        write_png(
+            p,
+            out.width,
+            out.height,
+            &out.total,
+            auto_exposure(&out.total),
+        )?;
     }
-    Ok(summary(&scene, &settings, &out, write_t.elapsed().as_secs_f64()))
+    Ok(summary(
+        &scene,
+        &settings,
+        &out,
+        write_t.elapsed().as_secs_f64(),
+    ))
 }
 
 fn summary(scene: &Scene, s: &RenderSettings, out: &RenderOutput, write_seconds: f64) -> String {
@@ -178,13 +198,22 @@ fn summary(scene: &Scene, s: &RenderSettings, out: &RenderOutput, write_seconds:
     } else {
         let _ = writeln!(text, "irradiance samples: {}", out.irradiance_samples);
     }
-    let _ = writeln!(text, "translucent pixels: {}", out.translucent_pixels().len());
+    let _ = writeln!(
+        text,
+        "translucent pixels: {}",
+        out.translucent_pixels().len()
+    );
     let _ = writeln!(text, "stage        seconds");
     for st in &out.stages {
         let _ = writeln!(text, "{:<12} {:.4}", st.name, st.seconds);
     }
     let _ = writeln!(text, "{:<12} {:.4}", "write", write_seconds);
-    let _ = writeln!(text, "{:<12} {:.4}", "total", out.seconds_total() + write_seconds);
+    let _ = writeln!(
+        text,
+        "{:<12} {:.4}",
+        "total",
+        out.seconds_total() + write_seconds
+    );
     text
 }
 
@@ -305,12 +334,26 @@ pub fn run_diff(args: &DiffArgs) -> Result<String, Error> {
             "|a-b|/b",
         )?;
     }
+    let mean = |img: &[Rgb]| -> Rgb {
+        let mut m = [0.0; 3];
+        for &i in &pixels {
+            for c in 0..3 {
+                m[c] += img[i][c] / pixels.len().max(1) as f64;
+            }
+        }
+        m
+    };
+    let (ma, mb) = (mean(&img), mean(&reference));
+    let ratio = [0, 1, 2].map(|c| if mb[c] > 0.0 { ma[c] / mb[c] } else { 0.0 });
     Ok(format!(
-        "pixels {}\nrmse {:.6e}\nrel_rmse {:.6e}\nfrac_within_{} {:.4}\n",
+        "pixels {}\nrmse {:.6e}\nrel_rmse {:.6e}\nfrac_within_{} {:.4}\nmean_ratio {:.5} {:.5} {:.5}\n",
         pixels.len(),
         f.rmse,
         f.rel_rmse,
         args.eps,
-        f.frac_within_eps
+        f.frac_within_eps,
+        ratio[0],
+        ratio[1],
+        ratio[2]
     ))
 }

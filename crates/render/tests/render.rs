@@ -1,6 +1,8 @@
 //! End-to-end tests of the two references on scenes built in code: the flat-slab closed form,
 //! agreement of `pathtrace` with `exact`, determinism, and the irradiance samples' invariants.
 
+#![allow(clippy::needless_range_loop)]
+
 use glam::DVec3;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{Medium, ModelKind, fresnel_normalization, make_model};
@@ -18,7 +20,11 @@ fn uv_sphere(centre: DVec3, radius: f64, rings: u32, segments: u32) -> Mesh {
         let theta = PI * i as f64 / rings as f64;
         for j in 0..segments {
             let phi = 2.0 * PI * j as f64 / segments as f64;
-            let n = DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let n = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
             positions.push(centre + n * radius);
             normals.push(n);
         }
@@ -144,12 +150,17 @@ fn flat_slab_matches_closed_form() {
     // The camera looks straight down: cos θ_o ≈ 1 at the centre pixel.
     let ft = ft_dielectric(1.0, eta);
     for c in 0..3 {
-        let closed =
-            ft / (fresnel_normalization(eta) * PI) * ft * e0[c] * model.total_diffuse_reflectance(c);
+        let closed = ft / (fresnel_normalization(eta) * PI)
+            * ft
+            * e0[c]
+            * model.total_diffuse_reflectance(c);
         let got = out.subsurface[centre][c];
         let rel = (got - closed).abs() / closed;
         eprintln!("slab channel {c}: exact {got:.6e}, closed form {closed:.6e}, rel {rel:.2e}");
-        assert!(rel < 0.01, "channel {c}: exact {got} vs closed form {closed} ({rel:.4})");
+        assert!(
+            rel < 0.01,
+            "channel {c}: exact {got} vs closed form {closed} ({rel:.4})"
+        );
     }
 }
 
@@ -209,14 +220,20 @@ fn pathtrace_agrees_with_exact_on_a_sphere() {
     );
     let px = pixels(&exact);
     assert!(px.len() > 100, "the sphere covers {} pixels", px.len());
-    let se = pt.std_error.as_ref().expect("path tracer reports standard errors");
+    let se = pt
+        .std_error
+        .as_ref()
+        .expect("path tracer reports standard errors");
     // Aggregate: the image means agree within 3 standard errors of the path tracer's mean
     // plus 1 % for the point sum's discretisation.
     for c in 0..3 {
         let m_ex: f64 = px.iter().map(|&i| exact.subsurface[i][c]).sum::<f64>() / px.len() as f64;
         let m_pt: f64 = px.iter().map(|&i| pt.subsurface[i][c]).sum::<f64>() / px.len() as f64;
-        let se_mean = (px.iter().map(|&i| se[i][c] * se[i][c]).sum::<f64>()).sqrt() / px.len() as f64;
-        eprintln!("sphere channel {c}: exact mean {m_ex:.6e}, pathtrace {m_pt:.6e} ± {se_mean:.2e}");
+        let se_mean =
+            (px.iter().map(|&i| se[i][c] * se[i][c]).sum::<f64>()).sqrt() / px.len() as f64;
+        eprintln!(
+            "sphere channel {c}: exact mean {m_ex:.6e}, pathtrace {m_pt:.6e} ± {se_mean:.2e}"
+        );
         assert!(
             (m_ex - m_pt).abs() <= 3.0 * se_mean + 0.01 * m_ex,
             "channel {c}: exact mean {m_ex}, pathtrace mean {m_pt} ± {se_mean}"
@@ -258,9 +275,21 @@ fn renders_are_deterministic() {
         let (a, b) = (run(1), run(2));
         assert_eq!(a.subsurface, b.subsurface, "{method:?}");
         assert_eq!(a.total, b.total, "{method:?}");
-        assert!(a.subsurface.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+        assert!(
+            a.subsurface
+                .iter()
+                .flatten()
+                .all(|v| v.is_finite() && *v >= 0.0)
+        );
         if method == Method::PathTrace {
-            let other = render(&scene, &RenderSettings { seed: 4, ..s.clone() }, None);
+            let other = render(
+                &scene,
+                &RenderSettings {
+                    seed: 4,
+                    ..s.clone()
+                },
+                None,
+            );
             assert_ne!(a.subsurface, other.subsurface);
         }
     }
@@ -290,16 +319,28 @@ fn irradiance_samples_cover_the_object() {
         })
         .sum();
     let sum: f64 = s.samples.iter().map(|x| x.area).sum();
-    assert!((sum - area).abs() < 1e-9 * area, "areas sum to {sum}, mesh area {area}");
+    assert!(
+        (sum - area).abs() < 1e-9 * area,
+        "areas sum to {sum}, mesh area {area}"
+    );
     let medium = Medium::preset("skin1").unwrap();
-    let mfp = (0..3).map(|c| 1.0 / medium.sigma_t_reduced(c)).fold(f64::INFINITY, f64::min);
-    assert!(s.spacing >= 0.5 * mfp * 0.1 * (1.0 - 1e-12), "spacing {}", s.spacing);
+    let mfp = (0..3)
+        .map(|c| 1.0 / medium.sigma_t_reduced(c))
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        s.spacing >= 0.5 * mfp * 0.1 * (1.0 - 1e-12),
+        "spacing {}",
+        s.spacing
+    );
     // Brute-force minimum distance over a subset.
     let n = s.samples.len().min(1500);
     for i in 0..n {
         for j in 0..i {
             let d = (s.samples[i].position - s.samples[j].position).length();
-            assert!(d >= s.spacing * (1.0 - 1e-9), "samples {i} and {j} are {d} apart");
+            assert!(
+                d >= s.spacing * (1.0 - 1e-9),
+                "samples {i} and {j} are {d} apart"
+            );
         }
     }
     // Closed-form irradiance for unshadowed samples facing the light.
@@ -311,7 +352,11 @@ fn irradiance_samples_cover_the_object() {
         let cos = x.normal.dot(wi);
         if cos > 0.3 {
             let expect = ft_dielectric(cos, medium.eta()) * 10.0 * cos / d.length_squared();
-            assert!((x.irradiance[0] - expect).abs() < 1e-9 * expect, "{} vs {expect}", x.irradiance[0]);
+            assert!(
+                (x.irradiance[0] - expect).abs() < 1e-9 * expect,
+                "{} vs {expect}",
+                x.irradiance[0]
+            );
             checked += 1;
         }
     }

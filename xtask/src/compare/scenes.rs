@@ -8,13 +8,13 @@
 
 use super::output::{csv_num, md_num, md_pct, md_table, write_atomic};
 use super::{Context, Error, Experiment, Section};
-use sss_render::image::{read_exr, write_error_map, write_exr, write_png, auto_exposure};
+use sss_bssrdf::Rgb;
+use sss_render::image::{auto_exposure, read_exr, write_error_map, write_exr, write_png};
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::plot::{Series, SeriesStyle, line_plot};
 use sss_render::render::{Method, RenderOutput, RenderSettings, Stage, render};
 use sss_render::render_cli::{error_figures, relative_errors};
 use sss_render::scene::{self, LoadOptions, Scene, SceneErrorKind};
-use sss_bssrdf::Rgb;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -22,28 +22,40 @@ use std::path::{Path, PathBuf};
 pub const EPS: f64 = 0.05;
 
 /// Bumped whenever the reference renderer's output changes, to invalidate cached references.
-const REFERENCE_VERSION: u32 = 1;
+const REFERENCE_VERSION: u32 = 2;
 
 /// Stage columns of `results.csv`, in order. Methods report a subset; the rest stay empty.
 pub const STAGES: [&str; 6] = ["bvh", "gbuffer", "models", "samples", "shading", "opaque"];
 
 /// A rendering method with a one-parameter sweep.
-pub trait SceneMethod {
+pub trait SceneMethod: Sync {
     /// Name in reports (`exact`, `pathtrace`, ...).
     fn name(&self) -> &'static str;
     /// The swept parameter's name.
     fn param(&self) -> &'static str;
     /// Parameter values, cheapest first.
     fn values(&self, quick: bool) -> Vec<f64>;
-    /// Renders `scene` with the parameter at `value`.
-    fn run(&self, scene: &Scene, value: f64, seed: u64) -> RenderOutput;
+    /// Renders `scene` with the parameter at `value`; `base` holds the reference's settings
+    /// (seed, irradiance samples) for the method to start from.
+    fn run(&self, scene: &Scene, value: f64, base: &RenderSettings) -> RenderOutput;
 }
 
-/// The reference settings: exact at the default spacing.
-fn reference_settings(seed: u64) -> RenderSettings {
+/// Irradiance-sample spacing of the reference (in reduced mean free paths): the renderer's
+/// default, or twice it with `--quick`.
+pub fn reference_spacing(quick: bool) -> f64 {
+    let default = IrradianceSettings::default().spacing_mfp;
+    if quick { 2.0 * default } else { default }
+}
+
+/// The reference settings: `exact` at [`reference_spacing`].
+fn reference_settings(seed: u64, quick: bool) -> RenderSettings {
     RenderSettings {
         method: Method::Exact,
         seed,
+        irradiance: IrradianceSettings {
+            spacing_mfp: reference_spacing(quick),
+            ..IrradianceSettings::default()
+        },
         ..RenderSettings::default()
     }
 }
@@ -58,16 +70,19 @@ impl SceneMethod for ExactSpacing {
     fn param(&self) -> &'static str {
         "spacing_mfp"
     }
-    fn values(&self, _quick: bool) -> Vec<f64> {
-        vec![4.0, 2.0, 1.0]
+    fn values(&self, quick: bool) -> Vec<f64> {
+        // Coarser than the reference, by factors 8, 4, 2 (4, 2 with --quick).
+        let r = reference_spacing(quick);
+        let factors: &[f64] = if quick { &[4.0, 2.0] } else { &[8.0, 4.0, 2.0] };
+        factors.iter().map(|f| f * r).collect()
     }
-    fn run(&self, scene: &Scene, value: f64, seed: u64) -> RenderOutput {
+    fn run(&self, scene: &Scene, value: f64, base: &RenderSettings) -> RenderOutput {
         let s = RenderSettings {
             irradiance: IrradianceSettings {
                 spacing_mfp: value,
-                ..IrradianceSettings::default()
+                ..base.irradiance
             },
-            ..reference_settings(seed)
+            ..base.clone()
         };
         render(scene, &s, None)
     }
@@ -84,13 +99,17 @@ impl SceneMethod for PathTrace {
         "spp"
     }
     fn values(&self, quick: bool) -> Vec<f64> {
-        if quick { vec![1.0, 4.0, 16.0] } else { vec![1.0, 4.0, 16.0, 64.0] }
+        if quick {
+            vec![1.0, 4.0, 16.0]
+        } else {
+            vec![1.0, 4.0, 16.0, 64.0]
+        }
     }
-    fn run(&self, scene: &Scene, value: f64, seed: u64) -> RenderOutput {
+    fn run(&self, scene: &Scene, value: f64, base: &RenderSettings) -> RenderOutput {
         let s = RenderSettings {
             method: Method::PathTrace,
             spp: value as u32,
-            ..reference_settings(seed)
+            ..base.clone()
         };
         render(scene, &s, None)
     }
@@ -121,7 +140,12 @@ impl Run {
         self.stages.iter().map(|s| s.seconds).sum()
     }
     fn stage(&self, name: &str) -> Option<f64> {
-        let v: Vec<f64> = self.stages.iter().filter(|s| s.name == name).map(|s| s.seconds).collect();
+        let v: Vec<f64> = self
+            .stages
+            .iter()
+            .filter(|s| s.name == name)
+            .map(|s| s.seconds)
+            .collect();
         (!v.is_empty()).then(|| v.iter().sum())
     }
 }
@@ -166,7 +190,10 @@ fn csv_rows(runs: &[Run]) -> String {
 
 /// The scenes of a run: names of built-in scenes or paths to scene files. Scenes whose mesh is
 /// missing are skipped with a message.
-fn load_scenes(ctx: &Context<'_>) -> Result<(Vec<(Scene, String)>, Vec<String>), Error> {
+/// Loaded scenes with their TOML text (the reference cache key), and skip messages.
+type LoadedScenes = (Vec<(Scene, String)>, Vec<String>);
+
+fn load_scenes(ctx: &Context<'_>) -> Result<LoadedScenes, Error> {
     let cfg = ctx.config;
     let opts = LoadOptions {
         mesh_dirs: cfg.mesh_dirs.clone(),
@@ -175,13 +202,18 @@ fn load_scenes(ctx: &Context<'_>) -> Result<(Vec<(Scene, String)>, Vec<String>),
     let mut skipped = Vec::new();
     for name in &cfg.scenes {
         let path = Path::new(name);
-        let (loaded, text) = if !path.exists() && scene::BUILTIN_SCENES.iter().any(|(n, _)| n == name) {
-            let text = scene::BUILTIN_SCENES.iter().find(|(n, _)| n == name).map(|(_, t)| t.to_string()).unwrap_or_default();
-            (scene::builtin(name, &opts), text)
-        } else {
-            let text = std::fs::read_to_string(path).unwrap_or_default();
-            (scene::load(path, &opts), text)
-        };
+        let (loaded, text) =
+            if !path.exists() && scene::BUILTIN_SCENES.iter().any(|(n, _)| n == name) {
+                let text = scene::BUILTIN_SCENES
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map(|(_, t)| t.to_string())
+                    .unwrap_or_default();
+                (scene::builtin(name, &opts), text)
+            } else {
+                let text = std::fs::read_to_string(path).unwrap_or_default();
+                (scene::load(path, &opts), text)
+            };
         match loaded {
             Ok(mut s) => {
                 if cfg.quick {
@@ -222,31 +254,39 @@ struct Reference {
 
 fn reference(ctx: &Context<'_>, scene: &Scene, text: &str) -> Result<Reference, Error> {
     let cfg = ctx.config;
-    let key = fnv(
-        format!(
-            "v{REFERENCE_VERSION}|{text}|{}x{}|{}|{:?}",
-            scene.camera.width,
-            scene.camera.height,
-            cfg.seed,
-            reference_settings(cfg.seed)
-        )
-        .as_bytes(),
-    );
+    let key = fnv(format!(
+        "v{REFERENCE_VERSION}|{text}|{}x{}|{}|{:?}",
+        scene.camera.width,
+        scene.camera.height,
+        cfg.seed,
+        reference_settings(cfg.seed, cfg.quick)
+    )
+    .as_bytes());
     let dir = cfg.out.join("cache");
-    std::fs::create_dir_all(&dir).map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
     let path = dir.join(format!("scene_{}_{key:016x}.exr", scene.name));
     let meta = path.with_extension("txt");
     if !cfg.fresh
         && let (Ok((w, h, layers)), Ok(m)) = (read_exr(&path), std::fs::read_to_string(&meta))
         && (w, h) == (scene.camera.width, scene.camera.height)
     {
-        let get = |n: &str| layers.iter().find(|(name, _)| name == n).map(|(_, d)| d.clone());
+        let get = |n: &str| {
+            layers
+                .iter()
+                .find(|(name, _)| name == n)
+                .map(|(_, d)| d.clone())
+        };
         let mut it = m.split_whitespace();
         let seconds = it.next().and_then(|v| v.parse().ok());
         let samples = it.next().and_then(|v| v.parse().ok());
-        if let (Some(sub), Some(tot), Some(cov), Some(seconds), Some(samples)) =
-            (get("subsurface"), get("total"), get("coverage"), seconds, samples)
-        {
+        if let (Some(sub), Some(tot), Some(cov), Some(seconds), Some(samples)) = (
+            get("subsurface"),
+            get("total"),
+            get("coverage"),
+            seconds,
+            samples,
+        ) {
             (ctx.log)(&format!("scene {}: reference from cache", scene.name));
             return Ok(Reference {
                 subsurface: sub,
@@ -257,32 +297,49 @@ fn reference(ctx: &Context<'_>, scene: &Scene, text: &str) -> Result<Reference, 
             });
         }
     }
-    (ctx.log)(&format!("scene {}: rendering the exact reference", scene.name));
-    let out = render(scene, &reference_settings(cfg.seed), None);
+    (ctx.log)(&format!(
+        "scene {}: rendering the exact reference",
+        scene.name
+    ));
+    let out = render(scene, &reference_settings(cfg.seed, cfg.quick), None);
     let cov: Vec<Rgb> = out.coverage.iter().map(|&c| [c as f64; 3]).collect();
     write_exr(
         &path,
         out.width,
         out.height,
-        &[("subsurface", &out.subsurface), ("total", &out.total), ("coverage", &cov)],
+        &[
+            ("subsurface", &out.subsurface),
+            ("total", &out.total),
+            ("coverage", &cov),
+        ],
     )
     .map_err(|e| Error(e.to_string()))?;
-    write_atomic(&meta, format!("{} {}\n", out.seconds_total(), out.irradiance_samples).as_bytes())?;
+    write_atomic(
+        &meta,
+        format!("{} {}\n", out.seconds_total(), out.irradiance_samples).as_bytes(),
+    )?;
+    let seconds = out.seconds_total();
     Ok(Reference {
         subsurface: out.subsurface,
         total: out.total,
         coverage: out.coverage,
-        seconds: out.seconds_total(),
+        seconds,
         samples: out.irradiance_samples,
     })
 }
 
-fn run_timed(method: &dyn SceneMethod, scene: &Scene, value: f64, seed: u64, threads: usize) -> Result<RenderOutput, Error> {
+fn run_timed(
+    method: &dyn SceneMethod,
+    scene: &Scene,
+    value: f64,
+    base: &RenderSettings,
+    threads: usize,
+) -> Result<RenderOutput, Error> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| Error(format!("cannot start {threads} threads: {e}")))?;
-    Ok(pool.install(|| method.run(scene, value, seed)))
+    Ok(pool.install(|| method.run(scene, value, base)))
 }
 
 fn within_3se(out: &RenderOutput, reference: &[Rgb], pixels: &[usize]) -> Option<f64> {
@@ -302,9 +359,23 @@ fn within_3se(out: &RenderOutput, reference: &[Rgb], pixels: &[usize]) -> Option
     Some(ok as f64 / pixels.len() as f64)
 }
 
-fn write_images(dir: &Path, name: &str, out: &RenderOutput, reference: &[Rgb], pixels: &[usize], exposure: f64) -> Result<(), Error> {
+fn write_images(
+    dir: &Path,
+    name: &str,
+    out: &RenderOutput,
+    reference: &[Rgb],
+    pixels: &[usize],
+    exposure: f64,
+) -> Result<(), Error> {
     let e = |e: sss_render::Error| Error(e.to_string());
-    write_png(&dir.join(format!("{name}.png")), out.width, out.height, &out.subsurface, exposure).map_err(e)?;
+    write_png(
+        &dir.join(format!("{name}.png")),
+        out.width,
+        out.height,
+        &out.subsurface,
+        exposure,
+    )
+    .map_err(e)?;
     let rel = relative_errors(&out.subsurface, reference, pixels);
     let mut values = vec![None; out.subsurface.len()];
     for (k, &i) in pixels.iter().enumerate() {
@@ -339,26 +410,51 @@ impl Experiment for SceneComparison {
             thread_counts.push(1);
         }
         let methods = methods();
+        let base = reference_settings(cfg.seed, cfg.quick);
         let mut runs: Vec<Run> = Vec::new();
         let mut body = String::new();
         let mut summary_rows = Vec::new();
         for (scene, text) in &scenes {
             let reference = reference(ctx, scene, text)?;
-            let pixels: Vec<usize> = (0..reference.coverage.len()).filter(|&i| reference.coverage[i] > 0.0).collect();
+            let pixels: Vec<usize> = (0..reference.coverage.len())
+                .filter(|&i| reference.coverage[i] > 0.0)
+                .collect();
             let dir = cfg.out.join("scenes").join(&scene.name);
-            std::fs::create_dir_all(&dir).map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
+            std::fs::create_dir_all(&dir)
+                .map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
             let exposure = auto_exposure(&reference.subsurface);
             let e = |e: sss_render::Error| Error(e.to_string());
-            write_png(&dir.join("reference.png"), scene.camera.width, scene.camera.height, &reference.subsurface, exposure).map_err(e)?;
-            write_png(&dir.join("reference_total.png"), scene.camera.width, scene.camera.height, &reference.total, auto_exposure(&reference.total)).map_err(e)?;
+            write_png(
+                &dir.join("reference.png"),
+                scene.camera.width,
+                scene.camera.height,
+                &reference.subsurface,
+                exposure,
+            )
+            .map_err(e)?;
+            write_png(
+                &dir.join("reference_total.png"),
+                scene.camera.width,
+                scene.camera.height,
+                &reference.total,
+                auto_exposure(&reference.total),
+            )
+            .map_err(e)?;
             let mut series = Vec::new();
             for (mi, m) in methods.iter().enumerate() {
                 let values = m.values(cfg.quick);
                 let mut points = Vec::new();
                 for (vi, &v) in values.iter().enumerate() {
                     for &threads in &thread_counts {
-                        (ctx.log)(&format!("scene {}: {} {}={} ({} thread(s))", scene.name, m.name(), m.param(), v, threads));
-                        let out = run_timed(m.as_ref(), scene, v, cfg.seed, threads)?;
+                        (ctx.log)(&format!(
+                            "scene {}: {} {}={} ({} thread(s))",
+                            scene.name,
+                            m.name(),
+                            m.param(),
+                            v,
+                            threads
+                        ));
+                        let out = run_timed(m.as_ref(), scene, v, &base, threads)?;
                         let f = error_figures(&out.subsurface, &reference.subsurface, &pixels, EPS);
                         let run = Run {
                             scene: scene.name.clone(),
@@ -375,7 +471,14 @@ impl Experiment for SceneComparison {
                         if threads == all_threads {
                             points.push((run.seconds_total(), run.rmse));
                             if vi + 1 == values.len() {
-                                write_images(&dir, &format!("{}_{}", m.name(), v), &out, &reference.subsurface, &pixels, exposure)?;
+                                write_images(
+                                    &dir,
+                                    &format!("{}_{}", m.name(), v),
+                                    &out,
+                                    &reference.subsurface,
+                                    &pixels,
+                                    exposure,
+                                )?;
                             }
                         }
                         runs.push(run);
@@ -388,8 +491,19 @@ impl Experiment for SceneComparison {
                 );
             }
             let plot = cfg.out.join(format!("error_vs_time_{}.png", scene.name));
-            line_plot(&plot, &format!("{}: RMSE against exact vs. time ({} threads)", scene.name, all_threads), "seconds (total)", "RMSE", &series, true, true)
-                .map_err(|e| Error(e.to_string()))?;
+            line_plot(
+                &plot,
+                &format!(
+                    "{}: RMSE against exact vs. time ({} threads)",
+                    scene.name, all_threads
+                ),
+                "seconds (total)",
+                "RMSE",
+                &series,
+                true,
+                true,
+            )
+            .map_err(|e| Error(e.to_string()))?;
             // Per-scene table.
             let _ = writeln!(
                 body,
@@ -423,27 +537,46 @@ impl Experiment for SceneComparison {
                 })
                 .collect();
             body.push_str(&md_table(
-                &["method", "param", "threads", "total s", "shading s", "RMSE", "rel. RMSE", &format!("within {} %", EPS * 100.0), "within 3 SE"],
+                &[
+                    "method",
+                    "param",
+                    "threads",
+                    "total s",
+                    "shading s",
+                    "RMSE",
+                    "rel. RMSE",
+                    &format!("within {} %", EPS * 100.0),
+                    "within 3 SE",
+                ],
                 &rows,
             ));
             body.push('\n');
-            let best_pt = runs
-                .iter()
-                .filter(|r| r.scene == scene.name && r.method == "pathtrace" && r.threads == all_threads)
-                .last();
+            let best_pt = runs.iter().rev().find(|r| {
+                r.scene == scene.name && r.method == "pathtrace" && r.threads == all_threads
+            });
             summary_rows.push(vec![
                 scene.name.clone(),
                 pixels.len().to_string(),
                 reference.samples.to_string(),
                 md_num(Some(reference.seconds), 3),
-                best_pt.map_or("–".into(), |r| format!("{} spp: {} s", r.value, md_num(Some(r.seconds_total()), 3))),
+                best_pt.map_or("–".into(), |r| {
+                    format!("{} spp: {} s", r.value, md_num(Some(r.seconds_total()), 3))
+                }),
                 best_pt.map_or("–".into(), |r| md_pct(Some(r.rel_rmse))),
                 best_pt.map_or("–".into(), |r| md_pct(r.within_3se)),
             ]);
         }
         write_atomic(&cfg.out.join("results.csv"), csv_rows(&runs).as_bytes())?;
         let mut summary = md_table(
-            &["scene", "translucent pixels", "irradiance samples", "exact s", "pathtrace", "pathtrace rel. RMSE vs exact", "pathtrace pixels within 3 SE"],
+            &[
+                "scene",
+                "translucent pixels",
+                "irradiance samples",
+                "exact s",
+                "pathtrace",
+                "pathtrace rel. RMSE vs exact",
+                "pathtrace pixels within 3 SE",
+            ],
             &summary_rows,
         );
         for s in &skipped {
@@ -478,8 +611,22 @@ mod tests {
     #[test]
     fn csv_header_has_the_documented_columns() {
         let h = csv_header();
-        for col in ["scene", "method", "param", "value", "threads", "seconds_total", "seconds_shading", "rmse", "rel_rmse", "frac_within_eps"] {
-            assert!(h.split(',').any(|c| c.trim() == col), "{col} missing from {h}");
+        for col in [
+            "scene",
+            "method",
+            "param",
+            "value",
+            "threads",
+            "seconds_total",
+            "seconds_shading",
+            "rmse",
+            "rel_rmse",
+            "frac_within_eps",
+        ] {
+            assert!(
+                h.split(',').any(|c| c.trim() == col),
+                "{col} missing from {h}"
+            );
         }
     }
 }

@@ -14,10 +14,7 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
     if shading.directional {
         // Full S of the directional dipole, positions in mm.
         let u = shading.units_per_mm;
-        let xo = SurfacePoint {
-            p: g.p / u,
-            n: g.n,
-        };
+        let xo = SurfacePoint { p: g.p / u, n: g.n };
         for (i, s) in samples.samples.iter().enumerate() {
             let xi = SurfacePoint {
                 p: s.position / u,
@@ -40,6 +37,10 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
         }
     }
     let mut out = [0.0; 3];
-    add_scaled(&mut out, sum, ft_dielectric(g.n.dot(g.wo), shading.eta) * shading.norm);
+    add_scaled(
+        &mut out,
+        sum,
+        ft_dielectric(g.n.dot(g.wo), shading.eta) * shading.norm,
+    );
     out
 }

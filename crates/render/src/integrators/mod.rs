@@ -56,7 +56,8 @@ impl TranslucentShading {
 /// The shading data of every material that some translucent object in `objects` uses (None
 /// for the others): models and tables are built only for what the image shows.
 pub fn shading_for(scene: &Scene, objects: &[u32]) -> Vec<Option<TranslucentShading>> {
-    let mut out: Vec<Option<TranslucentShading>> = (0..scene.materials.len()).map(|_| None).collect();
+    let mut out: Vec<Option<TranslucentShading>> =
+        (0..scene.materials.len()).map(|_| None).collect();
     for &o in objects {
         let m = scene.objects[o as usize].material;
         if out[m].is_none()

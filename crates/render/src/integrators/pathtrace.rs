@@ -20,7 +20,7 @@
 use super::TranslucentShading;
 use crate::gbuffer::GSample;
 use crate::geometry::{SceneGeometry, SurfaceHit};
-use crate::lights::{Incident, gather, tangent_frame};
+use crate::lights::{Incident, Receiver, gather, tangent_frame};
 use crate::scene::Light;
 use glam::DVec3;
 use rand::RngExt;
@@ -91,151 +91,190 @@ fn axes(n: DVec3) -> [DVec3; 3] {
     [s, t, n]
 }
 
-/// Combined density (per unit area, scene units²) of sampling `pi` from `po` over all nine
-/// techniques, counting for each technique the hits on its chord through `pi`.
-fn combined_pdf(
-    geom: &SceneGeometry,
-    shading: &TranslucentShading,
-    radii: &ProbeRadii,
-    object: u32,
-    po: DVec3,
-    axes: &[DVec3; 3],
-    pi: &SurfaceHit,
-    known: Option<(usize, &[(f64, SurfaceHit)], DVec3)>,
-    scratch: &mut Vec<(f64, SurfaceHit)>,
-) -> f64 {
-    let d = pi.p - po;
-    let dist2 = d.length_squared();
-    let rmax_all = radii.rmax.iter().copied().fold(0.0, f64::max);
-    let mut pdf = 0.0;
-    for (a, v) in axes.iter().enumerate() {
-        let along = d.dot(*v);
-        let rproj2 = (dist2 - along * along).max(0.0);
-        let rproj = rproj2.sqrt();
-        let cos = pi.ng.dot(*v).abs();
-        if !(cos > 0.0) || rproj > rmax_all {
-            continue;
-        }
-        // Hits along the line through pi parallel to v, as signed offsets from the point of
-        // the line closest to po (where the chords are centred).
-        let centre = po + (d - *v * along);
-        let offsets: Vec<f64> = match known {
-            Some((ka, hits, base)) if ka == a => hits.iter().map(|(_, h)| (h.p - base).dot(*v) - (centre - base).dot(*v)).collect(),
-            _ => {
+/// Hits along a chord: (distance from the chord's start, hit).
+pub type ChordHits = Vec<(f64, SurfaceHit)>;
+
+/// Reusable buffers of one worker, so sampling does not allocate.
+#[derive(Default)]
+pub struct Scratch {
+    hits: ChordHits,
+    chord: ChordHits,
+    packets: Vec<Incident>,
+}
+
+/// The sampled chord, reused for its own axis in [`Sampler::combined_pdf`]: its axis index,
+/// its hits and its start point.
+struct KnownChord<'h> {
+    axis: usize,
+    hits: &'h [(f64, SurfaceHit)],
+    base: DVec3,
+}
+
+/// What the sampler needs of the scene and of one material.
+pub struct Sampler<'a> {
+    /// Ray casting.
+    pub geom: &'a SceneGeometry,
+    /// The scene's lights.
+    pub lights: &'a [Light],
+    /// The material's model and units.
+    pub shading: &'a TranslucentShading,
+    /// The material's probe radii.
+    pub radii: &'a ProbeRadii,
+}
+
+impl Sampler<'_> {
+    /// Combined density (per unit area, scene units²) of sampling `pi` from `po` over all nine
+    /// techniques, counting for each technique the hits on its chord through `pi`.
+    fn combined_pdf(
+        &self,
+        object: u32,
+        po: DVec3,
+        axes: &[DVec3; 3],
+        pi: &SurfaceHit,
+        known: KnownChord<'_>,
+        scratch: &mut ChordHits,
+    ) -> f64 {
+        let (geom, shading, radii) = (self.geom, self.shading, self.radii);
+        let d = pi.p - po;
+        let dist2 = d.length_squared();
+        let rmax_all = radii.rmax.iter().copied().fold(0.0, f64::max);
+        let mut pdf = 0.0;
+        for (a, v) in axes.iter().enumerate() {
+            let along = d.dot(*v);
+            let rproj2 = (dist2 - along * along).max(0.0);
+            let rproj = rproj2.sqrt();
+            let cos = pi.ng.dot(*v).abs();
+            if !(cos > 0.0) || rproj > rmax_all {
+                continue;
+            }
+            // Hits along the line through pi parallel to v, as signed offsets from the point of
+            // the line closest to po (where the chords are centred).
+            let centre = po + (d - *v * along);
+            let offsets: Vec<f64> = if known.axis == a {
+                let base = known.base;
+                known
+                    .hits
+                    .iter()
+                    .map(|(_, h)| (h.p - base).dot(*v) - (centre - base).dot(*v))
+                    .collect()
+            } else {
                 let half = (rmax_all * rmax_all - rproj2).max(0.0).sqrt();
                 let base = centre - *v * half;
                 chord_hits(geom, object, base, *v, 2.0 * half, scratch);
                 scratch.iter().map(|(t, _)| t - half).collect()
+            };
+            for ch in 0..3 {
+                let rmax = radii.rmax[ch];
+                if !(rmax > 0.0) || dist2 > rmax * rmax || rproj > rmax {
+                    continue;
+                }
+                let half2 = rmax * rmax - rproj2;
+                let n = offsets.iter().filter(|o| **o * **o <= half2).count().max(1);
+                pdf += AXIS_PROB[a] / 3.0 * plane_pdf(shading, ch, rproj, rmax) * cos / n as f64;
             }
-        };
-        for ch in 0..3 {
-            let rmax = radii.rmax[ch];
-            if !(rmax > 0.0) || dist2 > rmax * rmax || rproj > rmax {
-                continue;
-            }
-            let half2 = rmax * rmax - rproj2;
-            let n = offsets.iter().filter(|o| **o * **o <= half2).count().max(1);
-            pdf += AXIS_PROB[a] / 3.0 * plane_pdf(shading, ch, rproj, rmax) * cos / n as f64;
         }
+        pdf
     }
-    pdf
-}
 
-/// One path-traced estimate of the subsurface radiance leaving `g`, and whether the probe found
-/// a point (an estimate of 0 with `false` still counts as a sample).
-pub fn sample(
-    geom: &SceneGeometry,
-    lights: &[Light],
-    g: &GSample,
-    shading: &TranslucentShading,
-    radii: &ProbeRadii,
-    rng: &mut Pcg64Mcg,
-    hits: &mut Vec<(f64, SurfaceHit)>,
-    scratch: &mut Vec<(f64, SurfaceHit)>,
-    packets: &mut Vec<Incident>,
-) -> Rgb {
-    let ax = axes(g.n);
-    // Choose axis and channel.
-    let u1: f64 = rng.random();
-    let (a, vx, vy) = if u1 < 0.5 {
-        (2, ax[0], ax[1])
-    } else if u1 < 0.75 {
-        (0, ax[1], ax[2])
-    } else {
-        (1, ax[2], ax[0])
-    };
-    let vz = ax[a];
-    let ch = rng.random_range(0..3usize);
-    let rmax = radii.rmax[ch];
-    if !(rmax > 0.0) {
-        return [0.0; 3];
-    }
-    let u = shading.units_per_mm;
-    let r = shading.model.sample_sr(ch, rng.random::<f64>()) * u;
-    if !(r.is_finite() && r >= 0.0) || r > rmax {
-        return [0.0; 3];
-    }
-    let phi = 2.0 * PI * rng.random::<f64>();
-    let rmax_all = radii.rmax.iter().copied().fold(0.0, f64::max);
-    let half_all = (rmax_all * rmax_all - r * r).max(0.0).sqrt();
-    let centre = g.p + (vx * phi.cos() + vy * phi.sin()) * r;
-    let base = centre - vz * half_all;
-    chord_hits(geom, g.object, base, vz, 2.0 * half_all, hits);
-    // This technique's chord is the part inside its own channel's sphere.
-    let half = (rmax * rmax - r * r).max(0.0).sqrt();
-    let mine: Vec<usize> = (0..hits.len())
-        .filter(|&k| (hits[k].0 - half_all).abs() <= half)
-        .collect();
-    if mine.is_empty() {
-        return [0.0; 3];
-    }
-    let pick = mine[rng.random_range(0..mine.len())];
-    let pi = hits[pick].1;
-    let pdf = combined_pdf(
-        geom,
-        shading,
-        radii,
-        g.object,
-        g.p,
-        &ax,
-        &pi,
-        Some((a, hits.as_slice(), base)),
-        scratch,
-    );
-    if !(pdf > 0.0) || !pdf.is_finite() {
-        return [0.0; 3];
-    }
-    // Direct light at the exit point.
-    packets.clear();
-    gather(geom, lights, pi.p, pi.n, pi.ng, 1, rng, packets);
-    if packets.is_empty() {
-        return [0.0; 3];
-    }
-    let tex = shading.texture.as_ref().map_or([1.0; 3], |t| t.eval(pi.p));
-    let mut out = [0.0; 3];
-    if shading.directional {
-        let xo = SurfacePoint { p: g.p / u, n: g.n };
-        let xi = SurfacePoint { p: pi.p / u, n: pi.n };
-        let s_area = 1.0 / (u * u * pdf);
-        for packet in packets.iter() {
-            let sv = shading.model.s(&xi, packet.dir, &xo, g.wo);
+    /// One path-traced estimate of the subsurface radiance leaving `g` (0 when the probe finds no
+    /// point; such samples still count).
+    pub fn sample(&self, g: &GSample, rng: &mut Pcg64Mcg, scratch: &mut Scratch) -> Rgb {
+        let (geom, lights, shading, radii) = (self.geom, self.lights, self.shading, self.radii);
+        let Scratch {
+            hits,
+            chord,
+            packets,
+        } = scratch;
+        let ax = axes(g.n);
+        // Choose axis and channel.
+        let u1: f64 = rng.random();
+        let (a, vx, vy) = if u1 < 0.5 {
+            (2, ax[0], ax[1])
+        } else if u1 < 0.75 {
+            (0, ax[1], ax[2])
+        } else {
+            (1, ax[2], ax[0])
+        };
+        let vz = ax[a];
+        let ch = rng.random_range(0..3usize);
+        let rmax = radii.rmax[ch];
+        if !(rmax > 0.0) {
+            return [0.0; 3];
+        }
+        let u = shading.units_per_mm;
+        let r = shading.model.sample_sr(ch, rng.random::<f64>()) * u;
+        if !(r.is_finite() && r >= 0.0) || r > rmax {
+            return [0.0; 3];
+        }
+        let phi = 2.0 * PI * rng.random::<f64>();
+        let rmax_all = radii.rmax.iter().copied().fold(0.0, f64::max);
+        let half_all = (rmax_all * rmax_all - r * r).max(0.0).sqrt();
+        let centre = g.p + (vx * phi.cos() + vy * phi.sin()) * r;
+        let base = centre - vz * half_all;
+        chord_hits(geom, g.object, base, vz, 2.0 * half_all, hits);
+        // This technique's chord is the part inside its own channel's sphere.
+        let half = (rmax * rmax - r * r).max(0.0).sqrt();
+        let mine: Vec<usize> = (0..hits.len())
+            .filter(|&k| (hits[k].0 - half_all).abs() <= half)
+            .collect();
+        if mine.is_empty() {
+            return [0.0; 3];
+        }
+        let pick = mine[rng.random_range(0..mine.len())];
+        let pi = hits[pick].1;
+        let known = KnownChord {
+            axis: a,
+            hits: hits.as_slice(),
+            base,
+        };
+        let pdf = self.combined_pdf(g.object, g.p, &ax, &pi, known, chord);
+        if !(pdf > 0.0) || !pdf.is_finite() {
+            return [0.0; 3];
+        }
+        // Direct light at the exit point.
+        packets.clear();
+        let at = Receiver {
+            p: pi.p,
+            n: pi.n,
+            ng: pi.ng,
+        };
+        gather(geom, lights, at, 1, rng, packets);
+        if packets.is_empty() {
+            return [0.0; 3];
+        }
+        let tex = shading.texture.as_ref().map_or([1.0; 3], |t| t.eval(pi.p));
+        let mut out = [0.0; 3];
+        if shading.directional {
+            let xo = SurfacePoint { p: g.p / u, n: g.n };
+            let xi = SurfacePoint {
+                p: pi.p / u,
+                n: pi.n,
+            };
+            let s_area = 1.0 / (u * u * pdf);
+            for packet in packets.iter() {
+                let sv = shading.model.s(&xi, packet.dir, &xo, g.wo);
+                for c in 0..3 {
+                    out[c] += sv[c] * packet.e_cos[c] * tex[c] * s_area;
+                }
+            }
+        } else {
+            let mut e = [0.0; 3];
+            for packet in packets.iter() {
+                let ft = ft_dielectric(pi.n.dot(packet.dir), shading.eta);
+                for c in 0..3 {
+                    e[c] += ft * packet.e_cos[c] * tex[c];
+                }
+            }
+            let rd = shading.rd_scene((pi.p - g.p).length());
+            let w = ft_dielectric(g.n.dot(g.wo), shading.eta) * shading.norm / pdf;
             for c in 0..3 {
-                out[c] += sv[c] * packet.e_cos[c] * tex[c] * s_area;
+                out[c] = rd[c] * e[c] * w;
             }
         }
-    } else {
-        let mut e = [0.0; 3];
-        for packet in packets.iter() {
-            let ft = ft_dielectric(pi.n.dot(packet.dir), shading.eta);
-            for c in 0..3 {
-                e[c] += ft * packet.e_cos[c] * tex[c];
-            }
-        }
-        let rd = shading.rd_scene((pi.p - g.p).length());
-        let w = ft_dielectric(g.n.dot(g.wo), shading.eta) * shading.norm / pdf;
-        for c in 0..3 {
-            out[c] = rd[c] * e[c] * w;
+        if out.iter().all(|v| v.is_finite()) {
+            out
+        } else {
+            [0.0; 3]
         }
     }
-    if out.iter().all(|v| v.is_finite()) { out } else { [0.0; 3] }
 }
