@@ -38,7 +38,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub threads: Option<usize>,
     /// Irradiance sample spacing in units of the smallest reduced mean free path.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub spacing: f64,
     /// At most this many irradiance samples per object.
     #[arg(long, default_value_t = 100_000)]

@@ -515,3 +515,151 @@ fn help_and_version_succeed() {
     assert!(h.contains("monte-carlo") && h.contains("--sigma-a"));
     assert!(ok(&["--version"]).starts_with("sss "));
 }
+
+/// A tiny scene file for render tests: a sphere under a point light, 12×10 pixels.
+fn tiny_scene(dir: &std::path::Path) -> PathBuf {
+    let path = dir.join("tiny.toml");
+    std::fs::write(
+        &path,
+        r#"
+[camera]
+position = [0.0, 0.0, 4.0]
+target = [0.0, 0.0, 0.0]
+fov = 35.0
+resolution = [12, 10]
+
+[[lights]]
+type = "point"
+position = [2.0, 2.0, 3.0]
+intensity = 10.0
+
+[materials.skin]
+type = "translucent"
+model = "better-dipole"
+preset = "skin1"
+units_per_mm = 0.1
+
+[[objects]]
+shape = "sphere"
+radius = 1.0
+subdivisions = 3
+material = "skin"
+"#,
+    )
+    .unwrap();
+    path
+}
+
+#[test]
+fn render_writes_exr_and_png_and_reports_stages() {
+    let dir = tmp_dir("render");
+    let scene = tiny_scene(&dir);
+    let exr = dir.join("a.exr");
+    let png = dir.join("a.png");
+    let text = ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--method",
+        "pathtrace",
+        "--spp",
+        "4",
+        "--out",
+        exr.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--threads",
+        "2",
+    ]);
+    for stage in ["bvh", "gbuffer", "shading", "total"] {
+        assert!(text.lines().any(|l| l.starts_with(stage)), "no {stage} line in\n{text}");
+    }
+    let (w, h, layers) = sss_render::image::read_exr(&exr).unwrap();
+    assert_eq!((w, h), (12, 10));
+    let names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+    for n in ["total", "subsurface", "std_error"] {
+        assert!(names.contains(&n), "{names:?}");
+    }
+    let sub = &layers.iter().find(|(n, _)| n == "subsurface").unwrap().1;
+    assert!(sub.iter().flatten().any(|v| *v > 0.0));
+    assert!(sub.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    // No temporary files left behind.
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+
+    // The same seed gives the same bits; the exact reference differs from a noisy render and
+    // `sss diff` measures it and draws the error map.
+    let exr2 = dir.join("b.exr");
+    ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--method",
+        "pathtrace",
+        "--spp",
+        "4",
+        "--out",
+        exr2.to_str().unwrap(),
+        "--threads",
+        "1",
+    ]);
+    let (_, _, again) = sss_render::image::read_exr(&exr2).unwrap();
+    assert_eq!(layers, again, "same seed, different thread count, different image");
+    let reference = dir.join("ref.exr");
+    ok(&["render", scene.to_str().unwrap(), "--out", reference.to_str().unwrap()]);
+    let err_png = dir.join("err.png");
+    let diff = ok(&[
+        "diff",
+        exr.to_str().unwrap(),
+        reference.to_str().unwrap(),
+        "--png",
+        err_png.to_str().unwrap(),
+    ]);
+    let rmse: f64 = diff
+        .lines()
+        .find_map(|l| l.strip_prefix("rmse "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(rmse > 0.0 && rmse.is_finite(), "{diff}");
+    let same = ok(&["diff", reference.to_str().unwrap(), reference.to_str().unwrap()]);
+    assert!(same.contains("rmse 0.000000e0"), "{same}");
+    assert!(std::fs::metadata(&err_png).unwrap().len() > 100);
+}
+
+#[test]
+fn render_bad_input_fails_with_one_line() {
+    let dir = tmp_dir("render-bad");
+    let scene = tiny_scene(&dir);
+    let scene = scene.to_str().unwrap();
+    let bad_toml = dir.join("bad.toml");
+    std::fs::write(&bad_toml, "[camera]\nposition = [0, 0]\n").unwrap();
+    let missing_dir = dir.join("no-such-dir").join("x.exr");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["render", "no-such-scene"], "no-such-scene"),
+        (vec!["render", bad_toml.to_str().unwrap()], "bad.toml"),
+        (vec!["render", scene, "--out", "x.png"], ".exr"),
+        (vec!["render", scene, "--png", "x.exr"], ".png"),
+        (vec!["render", scene, "--out", missing_dir.to_str().unwrap()], "no-such-dir"),
+        (vec!["render", scene, "--spp", "0", "--method", "pathtrace"], "--spp"),
+        (vec!["render", scene, "--spacing", "-1"], "--spacing"),
+        (vec!["render", scene, "--threads", "0"], "--threads"),
+        (vec!["render", scene, "--method", "magic"], "magic"),
+        (vec!["diff", "nope-a.exr", "nope-b.exr"], "nope-a.exr"),
+    ];
+    for (args, needle) in cases {
+        let o = sss(&args);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+        assert!(stdout(&o).is_empty(), "{args:?}");
+    }
+    assert!(!missing_dir.exists());
+}
