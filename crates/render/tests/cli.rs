@@ -571,7 +571,10 @@ fn render_writes_exr_and_png_and_reports_stages() {
         "2",
     ]);
     for stage in ["bvh", "gbuffer", "shading", "total"] {
-        assert!(text.lines().any(|l| l.starts_with(stage)), "no {stage} line in\n{text}");
+        assert!(
+            text.lines().any(|l| l.starts_with(stage)),
+            "no {stage} line in\n{text}"
+        );
     }
     let (w, h, layers) = sss_render::image::read_exr(&exr).unwrap();
     assert_eq!((w, h), (12, 10));
@@ -609,9 +612,17 @@ fn render_writes_exr_and_png_and_reports_stages() {
         "1",
     ]);
     let (_, _, again) = sss_render::image::read_exr(&exr2).unwrap();
-    assert_eq!(layers, again, "same seed, different thread count, different image");
+    assert_eq!(
+        layers, again,
+        "same seed, different thread count, different image"
+    );
     let reference = dir.join("ref.exr");
-    ok(&["render", scene.to_str().unwrap(), "--out", reference.to_str().unwrap()]);
+    ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        reference.to_str().unwrap(),
+    ]);
     let err_png = dir.join("err.png");
     let diff = ok(&[
         "diff",
@@ -627,7 +638,11 @@ fn render_writes_exr_and_png_and_reports_stages() {
         .parse()
         .unwrap();
     assert!(rmse > 0.0 && rmse.is_finite(), "{diff}");
-    let same = ok(&["diff", reference.to_str().unwrap(), reference.to_str().unwrap()]);
+    let same = ok(&[
+        "diff",
+        reference.to_str().unwrap(),
+        reference.to_str().unwrap(),
+    ]);
     assert!(same.contains("rmse 0.000000e0"), "{same}");
     assert!(std::fs::metadata(&err_png).unwrap().len() > 100);
 }
@@ -645,8 +660,14 @@ fn render_bad_input_fails_with_one_line() {
         (vec!["render", bad_toml.to_str().unwrap()], "bad.toml"),
         (vec!["render", scene, "--out", "x.png"], ".exr"),
         (vec!["render", scene, "--png", "x.exr"], ".png"),
-        (vec!["render", scene, "--out", missing_dir.to_str().unwrap()], "no-such-dir"),
-        (vec!["render", scene, "--spp", "0", "--method", "pathtrace"], "--spp"),
+        (
+            vec!["render", scene, "--out", missing_dir.to_str().unwrap()],
+            "no-such-dir",
+        ),
+        (
+            vec!["render", scene, "--spp", "0", "--method", "pathtrace"],
+            "--spp",
+        ),
         (vec!["render", scene, "--spacing", "-1"], "--spacing"),
         (vec!["render", scene, "--threads", "0"], "--threads"),
         (vec!["render", scene, "--method", "magic"], "magic"),
