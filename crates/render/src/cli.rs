@@ -3,6 +3,7 @@
 //! (2 for bad input, 1 for failures while running); nothing is written to stdout then.
 
 use crate::Error;
+use crate::kernel_cli::{KernelArgs, run_kernel};
 use crate::presets_table::presets_table;
 use crate::profile::{MediumSpec, ProfileModel, ProfileRequest, compute};
 use crate::render_cli::{DiffArgs, RenderArgs, run_diff, run_render};
@@ -33,6 +34,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Compare two renders: error figures and a false-colour error map.
     Diff(DiffArgs),
+    /// Export a separable screen-space kernel (JSON, CSV, GLSL or HLSL).
+    Kernel(KernelArgs),
 }
 
 /// Arguments of `sss profile`.
@@ -139,6 +142,7 @@ pub fn run(cli: &Cli, out: &mut dyn Write) -> Result<(), Error> {
         Command::Presets(args) => presets_table(args.csv).into_bytes(),
         Command::Render(args) => run_render(args)?.into_bytes(),
         Command::Diff(args) => run_diff(args)?.into_bytes(),
+        Command::Kernel(args) => run_kernel(args)?.into_bytes(),
         Command::Profile(args) => {
             let req = args.request()?;
             if let Some(path) = &args.plot {
@@ -202,7 +206,7 @@ pub fn main(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
                     eprintln!(
-                        "error: a subcommand is required (profile, presets, render or diff); see `sss --help`"
+                        "error: a subcommand is required (profile, presets, render, diff or kernel); see `sss --help`"
                     );
                     return ExitCode::from(2);
                 }

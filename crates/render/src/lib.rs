@@ -38,6 +38,7 @@ pub mod geometry;
 pub mod image;
 pub mod integrators;
 pub mod irradiance;
+pub mod kernel_cli;
 pub mod lights;
 pub mod plot;
 pub mod presets_table;

@@ -5,6 +5,9 @@
 use crate::gbuffer::{GBuffer, GSample};
 use crate::geometry::SceneGeometry;
 use crate::integrators::pathtrace::{self, ProbeRadii};
+use crate::integrators::separable::{
+    MaterialKernel, SeparableSettings, build_kernel, filter_options,
+};
 use crate::integrators::{TranslucentShading, exact, shading_for};
 use crate::irradiance::{self, IrradianceSettings, ObjectSamples};
 use crate::lights::{Receiver, background, gather};
@@ -23,6 +26,8 @@ pub enum Method {
     Exact,
     /// BSSRDF importance sampling with probe rays (pbrt §15.4).
     PathTrace,
+    /// Screen-space separable blur of the irradiance (Jimenez et al. 2015).
+    Separable,
 }
 
 impl Method {
@@ -31,6 +36,7 @@ impl Method {
         match self {
             Method::Exact => "exact",
             Method::PathTrace => "pathtrace",
+            Method::Separable => "separable",
         }
     }
 }
@@ -48,6 +54,8 @@ pub struct RenderSettings {
     pub irradiance: IrradianceSettings,
     /// Light samples per quad or environment light when shading opaque surfaces.
     pub opaque_light_samples: u32,
+    /// The separable integrator's kernel and filter.
+    pub separable: SeparableSettings,
 }
 
 impl Default for RenderSettings {
@@ -58,6 +66,7 @@ impl Default for RenderSettings {
             seed: 1,
             irradiance: IrradianceSettings::default(),
             opaque_light_samples: 16,
+            separable: SeparableSettings::default(),
         }
     }
 }
@@ -281,12 +290,13 @@ impl Prepared<'_> {
     }
 }
 
-/// Renders `scene` with `settings`. `progress`, if given, counts shaded pixel samples.
+/// Renders `scene` with `settings`. `progress`, if given, counts shaded pixel samples. Fails
+/// only when the separable integrator cannot build a kernel.
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
     progress: Option<&ProgressBar>,
-) -> RenderOutput {
+) -> Result<RenderOutput, crate::Error> {
     let mut prep = prepare(scene, settings.seed);
     let n = prep.gbuffer.samples.len();
     if let Some(p) = progress {
@@ -320,7 +330,7 @@ pub fn render(
                 name: "shading",
                 seconds: t.elapsed().as_secs_f64(),
             });
-            prep.assemble(&values, None, settings, count, spacing)
+            Ok(prep.assemble(&values, None, settings, count, spacing))
         }
         Method::PathTrace => {
             let t = Instant::now();
@@ -396,7 +406,148 @@ pub fn render(
                     v.map(|x| x.sqrt())
                 })
                 .collect();
-            prep.assemble(&values, Some(se), settings, 0, Vec::new())
+            Ok(prep.assemble(&values, Some(se), settings, 0, Vec::new()))
+        }
+        Method::Separable => render_separable(&mut prep, settings, progress),
+    }
+}
+
+/// The separable integrator (see [`crate::integrators::separable`]): irradiance at the pixels,
+/// a kernel per visible translucent material, one screen-space filter run per material.
+fn render_separable(
+    prep: &mut Prepared<'_>,
+    settings: &RenderSettings,
+    progress: Option<&ProgressBar>,
+) -> Result<RenderOutput, crate::Error> {
+    use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
+    let scene = prep.scene;
+    // Fresnel-transmitted, textured irradiance at every translucent pixel sample.
+    let t = Instant::now();
+    let light_samples = settings.irradiance.light_samples;
+    let irradiance: Vec<Rgb> = prep
+        .gbuffer
+        .samples
+        .par_iter()
+        .enumerate()
+        .map(|(k, g)| {
+            let Some(sh) = prep.shading_of(g.object) else {
+                return [0.0; 3];
+            };
+            let mut r = rng(settings.seed, Stream::Irradiance, (1u64 << 62) ^ k as u64);
+            let mut packets = Vec::new();
+            let at = Receiver {
+                p: g.p,
+                n: g.n,
+                ng: g.ng,
+            };
+            gather(
+                &prep.geom,
+                &scene.lights,
+                at,
+                light_samples,
+                &mut r,
+                &mut packets,
+            );
+            let tex = sh.texture.as_ref().map_or([1.0; 3], |t| t.eval(g.p));
+            let mut e = [0.0; 3];
+            for p in &packets {
+                let ft = sss_bssrdf::fresnel::ft_dielectric(g.n.dot(p.dir), sh.eta);
+                for c in 0..3 {
+                    e[c] += ft * p.e_cos[c] * tex[c];
+                }
+            }
+            e
+        })
+        .collect();
+    prep.stages.push(Stage {
+        name: "irradiance",
+        seconds: t.elapsed().as_secs_f64(),
+    });
+    // One kernel per material in use.
+    let t = Instant::now();
+    let mut kernels: Vec<Option<MaterialKernel>> = Vec::new();
+    for (m, sh) in prep.shading.iter().enumerate() {
+        kernels.push(match sh {
+            Some(sh) => Some(
+                build_kernel(sh.model.as_ref(), &settings.separable).map_err(|e| {
+                    crate::Error::Input(format!(
+                        "material `{}`: cannot build the {} kernel: {e}",
+                        scene.materials[m].name, settings.separable.kernel
+                    ))
+                })?,
+            ),
+            None => None,
+        });
+    }
+    prep.stages.push(Stage {
+        name: "kernels",
+        seconds: t.elapsed().as_secs_f64(),
+    });
+    // Filter each material's pixels.
+    let t = Instant::now();
+    let gb = &prep.gbuffer;
+    let (w, h) = (gb.width as usize, gb.height as usize);
+    let mut values = vec![[0.0; 3]; gb.samples.len()];
+    let opts = filter_options(&settings.separable, settings.seed);
+    for (m, kernel) in kernels.iter().enumerate() {
+        let (Some(kernel), Some(sh)) = (kernel, prep.shading[m].as_ref()) else {
+            continue;
+        };
+        let u = sh.units_per_mm;
+        let mut e = vec![[0.0f32; 3]; w * h];
+        let mut depth = vec![0.0f32; w * h];
+        let mut mask = vec![NO_OBJECT; w * h];
+        let mut mm = vec![0.0f32; w * h];
+        for i in 0..w * h {
+            let mut count = 0.0;
+            let mut sum = [0.0; 3];
+            for k in gb.offsets[i] as usize..gb.offsets[i + 1] as usize {
+                let g = &gb.samples[k];
+                if scene.objects[g.object as usize].material != m {
+                    continue;
+                }
+                if count == 0.0 {
+                    mask[i] = g.object;
+                    depth[i] = (g.distance / u) as f32;
+                    mm[i] = (g.footprint / u) as f32;
+                }
+                for c in 0..3 {
+                    sum[c] += irradiance[k][c];
+                }
+                count += 1.0;
+            }
+            if count > 0.0 {
+                e[i] = sum.map(|v| (v / count) as f32);
+            }
+        }
+        let input = ScreenInput {
+            width: w,
+            height: h,
+            irradiance: &e,
+            depth: &depth,
+            mask: &mask,
+            mm_per_pixel: &mm,
+        };
+        let filtered = match kernel {
+            MaterialKernel::Separable(k) => screen_space::filter(&input, k, &opts),
+            MaterialKernel::Full(k2) => convolve2d::exact(&input, k2, &opts),
+        }
+        .map_err(|e| crate::Error::Input(format!("separable filter: {e}")))?;
+        for (k, g) in gb.samples.iter().enumerate() {
+            if scene.objects[g.object as usize].material != m {
+                continue;
+            }
+            let f = filtered[g.pixel as usize];
+            let s = sss_bssrdf::fresnel::ft_dielectric(g.n.dot(g.wo), sh.eta) * sh.norm;
+            values[k] = [f[0] as f64 * s, f[1] as f64 * s, f[2] as f64 * s];
         }
     }
+    if let Some(p) = progress {
+        p.inc(gb.samples.len() as u64);
+    }
+    prep.stages.push(Stage {
+        name: "shading",
+        seconds: t.elapsed().as_secs_f64(),
+    });
+    Ok(prep.assemble(&values, None, settings, 0, Vec::new()))
 }

@@ -1,6 +1,7 @@
 //! `sss render` and `sss diff`: argument structures and what they run.
 
 use crate::image::{auto_exposure, read_exr, write_error_map, write_exr, write_png};
+use crate::integrators::separable::{KernelMethod, SeparableSettings};
 use crate::irradiance::IrradianceSettings;
 use crate::render::{Method, RenderOutput, RenderSettings, render};
 use crate::scene::{self, LoadOptions, Scene};
@@ -17,6 +18,8 @@ pub enum MethodArg {
     Exact,
     /// BSSRDF importance-sampled path tracing (pbrt §15.4).
     Pathtrace,
+    /// Screen-space separable blur (Jimenez et al. 2015).
+    Separable,
 }
 
 /// Arguments of `sss render`.
@@ -31,6 +34,23 @@ pub struct RenderArgs {
     /// Path tracer: BSSRDF samples per pixel sample.
     #[arg(long, default_value_t = 16)]
     pub spp: u32,
+    /// Separable: the kernel (preintegrated, svd1, svd3, svd6, artist, guided, gaussians1,
+    /// gaussians6, or exact2d for the brute-force 2D screen-space convolution).
+    #[arg(long, default_value = "preintegrated")]
+    pub kernel: KernelMethod,
+    /// Separable: taps per 1D pass.
+    #[arg(long, default_value_t = 7)]
+    pub taps: usize,
+    /// Separable: place taps uniformly instead of by importance.
+    #[arg(long)]
+    pub uniform_taps: bool,
+    /// Separable: guided-optimisation exponent k in [0, 4].
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    pub k: f64,
+    /// Separable: fraction of the kernel support within which the filter axes are rotated per
+    /// pixel (0 turns the jitter off).
+    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
+    pub jitter: f32,
     /// Seed of every random choice (same seed, same image).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -116,6 +136,24 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
     if args.spp == 0 {
         return Err(Error::Input("--spp must be at least 1".into()));
     }
+    if args.taps == 0 || args.taps > 1025 {
+        return Err(Error::Input(format!(
+            "--taps must lie in 1..=1025, got {}",
+            args.taps
+        )));
+    }
+    if !(0.0..=4.0).contains(&args.k) {
+        return Err(Error::Input(format!(
+            "--k must lie in [0, 4], got {}",
+            args.k
+        )));
+    }
+    if !(0.0..=1.0).contains(&args.jitter) {
+        return Err(Error::Input(format!(
+            "--jitter must lie in [0, 1], got {}",
+            args.jitter
+        )));
+    }
     if args.threads == Some(0) {
         return Err(Error::Input("--threads must be at least 1".into()));
     }
@@ -133,6 +171,14 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
         method: match args.method {
             MethodArg::Exact => Method::Exact,
             MethodArg::Pathtrace => Method::PathTrace,
+            MethodArg::Separable => Method::Separable,
+        },
+        separable: SeparableSettings {
+            kernel: args.kernel,
+            taps: args.taps,
+            importance: !args.uniform_taps,
+            k: args.k,
+            jitter: args.jitter,
         },
         spp: args.spp,
         seed: args.seed,
@@ -155,6 +201,7 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
     let bar = progress::bar(0, "pixel samples");
     let out = pool.install(|| render(&scene, &settings, Some(&bar)));
     bar.finish_and_clear();
+    let out = out?;
     let write_t = std::time::Instant::now();
     if let Some(p) = &args.out {
         let mut layers: Vec<(&str, &[Rgb])> =
@@ -195,6 +242,19 @@ fn summary(scene: &Scene, s: &RenderSettings, out: &RenderOutput, write_seconds:
     );
     if s.method == Method::PathTrace {
         let _ = writeln!(text, "bssrdf samples per pixel sample: {}", s.spp);
+    } else if s.method == Method::Separable {
+        let _ = writeln!(
+            text,
+            "kernel {}, {} {} taps per pass, jitter {}",
+            s.separable.kernel,
+            s.separable.taps,
+            if s.separable.importance {
+                "importance-sampled"
+            } else {
+                "uniform"
+            },
+            s.separable.jitter
+        );
     } else {
         let _ = writeln!(text, "irradiance samples: {}", out.irradiance_samples);
     }

@@ -684,3 +684,172 @@ fn render_bad_input_fails_with_one_line() {
     }
     assert!(!missing_dir.exists());
 }
+
+/// `sss kernel` JSON: per-channel weight sums equal the model's total diffuse reflectance (or 1
+/// with --normalize), for every rank-1 method; multi-term kernels export terms whose products
+/// sum to it.
+#[test]
+fn kernel_export_conserves_energy() {
+    let model = make_model(ModelKind::BetterDipole, &Medium::preset("skin1").unwrap());
+    let total: Vec<f64> = (0..3).map(|c| model.total_diffuse_reflectance(c)).collect();
+    let sums = |taps: &serde_json::Value| -> Vec<f64> {
+        let mut s = vec![0.0; 3];
+        for t in taps.as_array().unwrap() {
+            for (c, v) in t["weights"].as_array().unwrap().iter().enumerate() {
+                s[c] += v.as_f64().unwrap();
+            }
+        }
+        s
+    };
+    for method in ["preintegrated", "svd1", "artist", "guided", "gaussians1"] {
+        for normalize in [false, true] {
+            let mut args = vec![
+                "kernel", "--preset", "skin1", "--method", method, "--taps", "9",
+            ];
+            if normalize {
+                args.push("--normalize");
+            }
+            let v: serde_json::Value = serde_json::from_str(&ok(&args)).unwrap();
+            assert_eq!(v["normalized"].as_bool(), Some(normalize));
+            assert_eq!(v["taps"].as_array().unwrap().len(), 9, "{method}");
+            let s = sums(&v["taps"]);
+            for c in 0..3 {
+                let want = if normalize { 1.0 } else { total[c] };
+                assert!(
+                    rel_close(s[c], want, 1e-9),
+                    "{method} ch {c}: {} vs {want}",
+                    s[c]
+                );
+            }
+        }
+    }
+    for method in ["svd3", "gaussians6"] {
+        let v: serde_json::Value =
+            serde_json::from_str(&ok(&["kernel", "--preset", "skin1", "--method", method]))
+                .unwrap();
+        let terms = v["terms"].as_array().unwrap();
+        assert!(terms.len() > 1, "{method}");
+        let mut e = [0.0; 3];
+        for t in terms {
+            let (h, vv) = (sums(&t["horizontal"]), sums(&t["vertical"]));
+            for c in 0..3 {
+                e[c] += h[c] * vv[c];
+            }
+        }
+        for c in 0..3 {
+            assert!(
+                rel_close(e[c], total[c], 1e-9),
+                "{method} ch {c}: {} vs {}",
+                e[c],
+                total[c]
+            );
+        }
+    }
+    // GLSL/HLSL: one float4 per tap, centre first; CSV one row per tap.
+    let glsl = ok(&[
+        "kernel", "--preset", "marble", "--format", "glsl", "--taps", "7",
+    ]);
+    assert!(glsl.contains("vec4 sssKernel[7]"), "{glsl}");
+    assert_eq!(glsl.matches("vec4(").count(), 7);
+    assert!(glsl.contains(", 0.0)"), "centre tap first: {glsl}");
+    let hlsl = ok(&[
+        "kernel", "--preset", "marble", "--format", "hlsl", "--taps", "5",
+    ]);
+    assert!(hlsl.contains("static const float4 sssKernel[5]"), "{hlsl}");
+    let csv = ok(&[
+        "kernel", "--preset", "marble", "--format", "csv", "--taps", "5",
+    ]);
+    assert_eq!(csv.lines().count(), 6, "{csv}");
+    assert!(csv.starts_with("term,direction,offset_mm,weight_r,weight_g,weight_b"));
+}
+
+#[test]
+fn kernel_bad_input_fails_with_one_line() {
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["kernel", "--preset", "nope"], "nope"),
+        (vec!["kernel", "--preset", "skin1", "--taps", "0"], "--taps"),
+        (
+            vec!["kernel", "--preset", "skin1", "--method", "exact2d"],
+            "exact2d",
+        ),
+        (
+            vec!["kernel", "--preset", "skin1", "--method", "magic"],
+            "magic",
+        ),
+        (
+            vec![
+                "kernel", "--preset", "skin1", "--k", "5", "--method", "guided",
+            ],
+            "--k",
+        ),
+        (
+            vec![
+                "kernel",
+                "--preset",
+                "skin1",
+                "--artist-preset",
+                "production",
+            ],
+            "--method artist",
+        ),
+        (
+            vec![
+                "kernel",
+                "--preset",
+                "skin1",
+                "--method",
+                "artist",
+                "--artist-preset",
+                "x",
+            ],
+            "x",
+        ),
+        (
+            vec!["kernel", "--sigma-a", "-1,1,1", "--sigma-s", "1,1,1"],
+            "sigma_a",
+        ),
+        (
+            vec!["kernel", "--preset", "skin1", "--format", "yaml"],
+            "yaml",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = sss(&args);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+        assert!(stdout(&o).is_empty(), "{args:?}");
+    }
+}
+
+/// The separable integrator on a scene: close to the exact world-space reference on a sphere
+/// (screen-space blur of the same irradiance), energy kept, silhouettes respected.
+#[test]
+fn separable_render_is_close_to_exact() {
+    let dir = tmp_dir("separable");
+    let scene = tiny_scene(&dir);
+    let scene = scene.to_str().unwrap();
+    let ex = dir.join("ex.exr");
+    let sep = dir.join("sep.exr");
+    ok(&["render", scene, "--out", ex.to_str().unwrap()]);
+    ok(&[
+        "render",
+        scene,
+        "--method",
+        "separable",
+        "--out",
+        sep.to_str().unwrap(),
+    ]);
+    let d = ok(&["diff", sep.to_str().unwrap(), ex.to_str().unwrap()]);
+    let ratio: Vec<f64> = d
+        .lines()
+        .find_map(|l| l.strip_prefix("mean_ratio "))
+        .unwrap()
+        .split_whitespace()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    for r in ratio {
+        assert!((r - 1.0).abs() < 0.1, "{d}");
+    }
+}

@@ -142,7 +142,7 @@ fn flat_slab_matches_closed_form() {
         },
         ..RenderSettings::default()
     };
-    let out = render(&scene, &settings, None);
+    let out = render(&scene, &settings, None).unwrap();
     let medium = Medium::preset("marble").unwrap();
     let model = make_model(ModelKind::BetterDipole, &medium);
     let eta = medium.eta();
@@ -207,7 +207,8 @@ fn pathtrace_agrees_with_exact_on_a_sphere() {
             ..RenderSettings::default()
         },
         None,
-    );
+    )
+    .unwrap();
     let pt = render(
         &scene,
         &RenderSettings {
@@ -217,7 +218,8 @@ fn pathtrace_agrees_with_exact_on_a_sphere() {
             ..RenderSettings::default()
         },
         None,
-    );
+    )
+    .unwrap();
     let px = pixels(&exact);
     assert!(px.len() > 100, "the sphere covers {} pixels", px.len());
     let se = pt
@@ -270,7 +272,7 @@ fn renders_are_deterministic() {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| render(&scene, &s, None))
+                .install(|| render(&scene, &s, None).unwrap())
         };
         let (a, b) = (run(1), run(2));
         assert_eq!(a.subsurface, b.subsurface, "{method:?}");
@@ -289,7 +291,8 @@ fn renders_are_deterministic() {
                     ..s.clone()
                 },
                 None,
-            );
+            )
+            .unwrap();
             assert_ne!(a.subsurface, other.subsurface);
         }
     }

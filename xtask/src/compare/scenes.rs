@@ -10,6 +10,7 @@ use super::output::{csv_num, md_num, md_pct, md_table, write_atomic};
 use super::{Context, Error, Experiment, Section};
 use sss_bssrdf::Rgb;
 use sss_render::image::{auto_exposure, read_exr, write_error_map, write_exr, write_png};
+use sss_render::integrators::separable::SeparableSettings;
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::plot::{Series, SeriesStyle, line_plot};
 use sss_render::render::{Method, RenderOutput, RenderSettings, Stage, render};
@@ -25,7 +26,16 @@ pub const EPS: f64 = 0.05;
 const REFERENCE_VERSION: u32 = 2;
 
 /// Stage columns of `results.csv`, in order. Methods report a subset; the rest stay empty.
-pub const STAGES: [&str; 6] = ["bvh", "gbuffer", "models", "samples", "shading", "opaque"];
+pub const STAGES: [&str; 8] = [
+    "bvh",
+    "gbuffer",
+    "models",
+    "samples",
+    "irradiance",
+    "kernels",
+    "shading",
+    "opaque",
+];
 
 /// A rendering method with a one-parameter sweep.
 pub trait SceneMethod: Sync {
@@ -37,7 +47,12 @@ pub trait SceneMethod: Sync {
     fn values(&self, quick: bool) -> Vec<f64>;
     /// Renders `scene` with the parameter at `value`; `base` holds the reference's settings
     /// (seed, irradiance samples) for the method to start from.
-    fn run(&self, scene: &Scene, value: f64, base: &RenderSettings) -> RenderOutput;
+    fn run(
+        &self,
+        scene: &Scene,
+        value: f64,
+        base: &RenderSettings,
+    ) -> Result<RenderOutput, sss_render::Error>;
 }
 
 /// Irradiance-sample spacing of the reference (in reduced mean free paths): the renderer's
@@ -76,7 +91,12 @@ impl SceneMethod for ExactSpacing {
         let factors: &[f64] = if quick { &[4.0, 2.0] } else { &[8.0, 4.0, 2.0] };
         factors.iter().map(|f| f * r).collect()
     }
-    fn run(&self, scene: &Scene, value: f64, base: &RenderSettings) -> RenderOutput {
+    fn run(
+        &self,
+        scene: &Scene,
+        value: f64,
+        base: &RenderSettings,
+    ) -> Result<RenderOutput, sss_render::Error> {
         let s = RenderSettings {
             irradiance: IrradianceSettings {
                 spacing_mfp: value,
@@ -105,7 +125,12 @@ impl SceneMethod for PathTrace {
             vec![1.0, 4.0, 16.0, 64.0]
         }
     }
-    fn run(&self, scene: &Scene, value: f64, base: &RenderSettings) -> RenderOutput {
+    fn run(
+        &self,
+        scene: &Scene,
+        value: f64,
+        base: &RenderSettings,
+    ) -> Result<RenderOutput, sss_render::Error> {
         let s = RenderSettings {
             method: Method::PathTrace,
             spp: value as u32,
@@ -115,9 +140,49 @@ impl SceneMethod for PathTrace {
     }
 }
 
+/// The screen-space separable blur (Jimenez et al. 2015) with the pre-integrated kernel and
+/// importance-sampled taps, at growing tap counts.
+struct Separable;
+
+impl SceneMethod for Separable {
+    fn name(&self) -> &'static str {
+        "separable"
+    }
+    fn param(&self) -> &'static str {
+        "taps"
+    }
+    fn values(&self, quick: bool) -> Vec<f64> {
+        if quick {
+            vec![3.0, 7.0, 15.0]
+        } else {
+            vec![3.0, 7.0, 15.0, 31.0]
+        }
+    }
+    fn run(
+        &self,
+        scene: &Scene,
+        value: f64,
+        base: &RenderSettings,
+    ) -> Result<RenderOutput, sss_render::Error> {
+        let s = RenderSettings {
+            method: Method::Separable,
+            separable: SeparableSettings {
+                taps: value as usize,
+                ..SeparableSettings::default()
+            },
+            ..base.clone()
+        };
+        render(scene, &s, None)
+    }
+}
+
 /// Every registered rendering method (later issues add theirs here).
 pub fn methods() -> Vec<Box<dyn SceneMethod>> {
-    vec![Box::new(ExactSpacing), Box::new(PathTrace)]
+    vec![
+        Box::new(ExactSpacing),
+        Box::new(PathTrace),
+        Box::new(Separable),
+    ]
 }
 
 /// One run: a method at one parameter value with one thread count.
@@ -305,7 +370,8 @@ fn reference(ctx: &Context<'_>, scene: &Scene, text: &str) -> Result<Reference, 
         "scene {}: rendering the exact reference",
         scene.name
     ));
-    let out = render(scene, &reference_settings(cfg.seed, cfg.quick), None);
+    let out = render(scene, &reference_settings(cfg.seed, cfg.quick), None)
+        .map_err(|e| Error(format!("scene {}: reference: {e}", scene.name)))?;
     let cov: Vec<Rgb> = out.coverage.iter().map(|&c| [c as f64; 3]).collect();
     write_exr(
         &path,
@@ -343,7 +409,15 @@ fn run_timed(
         .num_threads(threads)
         .build()
         .map_err(|e| Error(format!("cannot start {threads} threads: {e}")))?;
-    Ok(pool.install(|| method.run(scene, value, base)))
+    pool.install(|| method.run(scene, value, base))
+        .map_err(|e| {
+            Error(format!(
+                "scene {}: {} {}={value}: {e}",
+                scene.name,
+                method.name(),
+                method.param()
+            ))
+        })
 }
 
 fn within_3se(out: &RenderOutput, reference: &[Rgb], pixels: &[usize]) -> Option<f64> {

@@ -7,6 +7,7 @@
 
 pub mod exact;
 pub mod pathtrace;
+pub mod separable;
 
 use crate::scene::{Scene, Texture, Translucent};
 use sss_bssrdf::{Bssrdf, ModelKind, Rgb, fresnel_normalization, make_model};
