@@ -10,6 +10,7 @@
 //! Everything random is seeded ([`Config::seed`]), so error figures are reproducible; only
 //! the timings vary from run to run.
 
+mod kernels;
 mod metrics;
 mod output;
 mod profiles;
@@ -104,6 +105,7 @@ fn experiments() -> Vec<Box<dyn Experiment>> {
     vec![
         Box::new(profiles::ProfileComparison),
         Box::new(scenes::SceneComparison),
+        Box::new(kernels::KernelComparison),
     ]
 }
 
