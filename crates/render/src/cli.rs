@@ -38,13 +38,10 @@ pub enum Command {
     Kernel(KernelArgs),
 }
 
-/// Arguments of `sss profile`.
+/// The medium of `sss profile` and `sss kernel`: a preset, or coefficients.
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("medium").required(true).args(["preset", "sigma_a"])))]
-pub struct ProfileArgs {
-    /// The model, or the Monte Carlo reference.
-    #[arg(long, value_enum)]
-    pub model: ProfileModel,
+pub struct MediumArgs {
     /// A measured material (see `sss presets`); g = 0 and sigma_s = sigma_s'.
     #[arg(long, conflicts_with_all = ["sigma_a", "sigma_s", "g"])]
     pub preset: Option<String>,
@@ -60,6 +57,34 @@ pub struct ProfileArgs {
     /// Relative index of refraction [default: 1.3].
     #[arg(long, allow_hyphen_values = true)]
     pub eta: Option<f64>,
+}
+
+impl MediumArgs {
+    /// The medium these arguments name (without η, which callers pass on separately).
+    pub fn spec(&self) -> Result<MediumSpec, Error> {
+        match (&self.preset, self.sigma_a, self.sigma_s) {
+            (Some(name), None, None) => Ok(MediumSpec::Preset(name.clone())),
+            (None, Some(sigma_a), Some(sigma_s)) => Ok(MediumSpec::Coefficients {
+                sigma_a,
+                sigma_s,
+                g: self.g.unwrap_or(0.0),
+            }),
+            _ => Err(Error::Input(
+                "give either --preset NAME or both --sigma-a R,G,B and --sigma-s R,G,B".into(),
+            )),
+        }
+    }
+}
+
+/// Arguments of `sss profile`.
+#[derive(Debug, Args)]
+pub struct ProfileArgs {
+    /// The model, or the Monte Carlo reference.
+    #[arg(long, value_enum)]
+    pub model: ProfileModel,
+    /// The medium.
+    #[command(flatten)]
+    pub medium: MediumArgs,
     /// Largest radius in mm.
     #[arg(long, allow_hyphen_values = true)]
     pub r_max: f64,
@@ -109,23 +134,11 @@ pub fn parse_rgb(s: &str) -> Result<Rgb, String> {
 impl ProfileArgs {
     /// The library request these arguments describe.
     pub fn request(&self) -> Result<ProfileRequest, Error> {
-        let medium = match (&self.preset, self.sigma_a, self.sigma_s) {
-            (Some(name), None, None) => MediumSpec::Preset(name.clone()),
-            (None, Some(sigma_a), Some(sigma_s)) => MediumSpec::Coefficients {
-                sigma_a,
-                sigma_s,
-                g: self.g.unwrap_or(0.0),
-            },
-            _ => {
-                return Err(Error::Input(
-                    "give either --preset NAME or both --sigma-a R,G,B and --sigma-s R,G,B".into(),
-                ));
-            }
-        };
+        let medium = self.medium.spec()?;
         Ok(ProfileRequest {
             model: self.model,
             medium,
-            eta: self.eta,
+            eta: self.medium.eta,
             r_max: self.r_max,
             steps: self.steps,
             log: self.log,

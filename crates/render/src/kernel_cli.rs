@@ -10,12 +10,13 @@
 //! each term's horizontal and vertical taps as stored (their products sum to R).
 
 use crate::Error;
-use crate::cli::parse_rgb;
+use crate::cli::MediumArgs;
 use crate::integrators::separable::{
     KernelMethod, MaterialKernel, SeparableSettings, build_kernel,
 };
 use crate::profile::{MediumSpec, build_medium};
-use clap::{ArgGroup, Args, ValueEnum};
+use crate::render_cli::check_separable_args;
+use clap::{Args, ValueEnum};
 use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_separable::{Kernel1d, SeparableKernel, TapPlacement, artist};
 use std::fmt::Write as _;
@@ -35,23 +36,10 @@ pub enum KernelFormat {
 
 /// Arguments of `sss kernel`.
 #[derive(Debug, Args)]
-#[command(group(ArgGroup::new("medium").required(true).args(["preset", "sigma_a"])))]
 pub struct KernelArgs {
-    /// A measured material (see `sss presets`).
-    #[arg(long, conflicts_with_all = ["sigma_a", "sigma_s", "g"])]
-    pub preset: Option<String>,
-    /// Absorption coefficients R,G,B in 1/mm.
-    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, allow_hyphen_values = true, requires = "sigma_s")]
-    pub sigma_a: Option<Rgb>,
-    /// Scattering coefficients R,G,B in 1/mm.
-    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, allow_hyphen_values = true, requires = "sigma_a")]
-    pub sigma_s: Option<Rgb>,
-    /// Henyey-Greenstein anisotropy (with --sigma-a/--sigma-s) [default: 0].
-    #[arg(long, allow_hyphen_values = true)]
-    pub g: Option<f64>,
-    /// Relative index of refraction [default: 1.3].
-    #[arg(long, allow_hyphen_values = true)]
-    pub eta: Option<f64>,
+    /// The medium.
+    #[command(flatten)]
+    pub medium: MediumArgs,
     /// The BSSRDF model whose R_d is approximated.
     #[arg(long, default_value = "better-dipole")]
     pub model: ModelKind,
@@ -177,18 +165,7 @@ fn float4_array(k: &Kernel1d, glsl: bool, name: &str) -> String {
 
 /// Runs `sss kernel`: the kernel text for stdout.
 pub fn run_kernel(args: &KernelArgs) -> Result<String, Error> {
-    if args.taps == 0 || args.taps > 1025 {
-        return Err(Error::Input(format!(
-            "--taps must lie in 1..=1025, got {}",
-            args.taps
-        )));
-    }
-    if !(0.0..=4.0).contains(&args.k) {
-        return Err(Error::Input(format!(
-            "--k must lie in [0, 4], got {}",
-            args.k
-        )));
-    }
+    check_separable_args(args.taps, args.k, 0.0)?;
     if args.method == KernelMethod::Exact2d {
         return Err(Error::Input(
             "--method exact2d is the full 2D kernel, not a separable one; choose preintegrated, svd1, svd3, svd6, artist, guided, gaussians1 or gaussians6".into(),
@@ -197,20 +174,8 @@ pub fn run_kernel(args: &KernelArgs) -> Result<String, Error> {
     if args.artist_preset.is_some() && args.method != KernelMethod::Artist {
         return Err(Error::Input("--artist-preset needs --method artist".into()));
     }
-    let spec = match (&args.preset, args.sigma_a, args.sigma_s) {
-        (Some(name), None, None) => MediumSpec::Preset(name.clone()),
-        (None, Some(sigma_a), Some(sigma_s)) => MediumSpec::Coefficients {
-            sigma_a,
-            sigma_s,
-            g: args.g.unwrap_or(0.0),
-        },
-        _ => {
-            return Err(Error::Input(
-                "give either --preset NAME or both --sigma-a R,G,B and --sigma-s R,G,B".into(),
-            ));
-        }
-    };
-    let medium = build_medium(&spec, args.eta)?;
+    let spec = args.medium.spec()?;
+    let medium = build_medium(&spec, args.medium.eta)?;
     let model = make_model(args.model, &medium);
     let total: Rgb = std::array::from_fn(|c| model.total_diffuse_reflectance(c));
     let placement = if args.uniform {

@@ -92,6 +92,24 @@ pub struct DiffArgs {
     pub eps: f64,
 }
 
+/// Checks the separable options shared by `sss render` and `sss kernel`.
+pub fn check_separable_args(taps: usize, k: f64, jitter: f32) -> Result<(), Error> {
+    if taps == 0 || taps > 1025 {
+        return Err(Error::Input(format!(
+            "--taps must lie in 1..=1025, got {taps}"
+        )));
+    }
+    if !(0.0..=4.0).contains(&k) {
+        return Err(Error::Input(format!("--k must lie in [0, 4], got {k}")));
+    }
+    if !(0.0..=1.0).contains(&jitter) {
+        return Err(Error::Input(format!(
+            "--jitter must lie in [0, 1], got {jitter}"
+        )));
+    }
+    Ok(())
+}
+
 /// Loads a scene file, or a built-in scene when `name` is not a file but names one.
 pub fn load_scene(name: &str, mesh_dirs: &[PathBuf]) -> Result<Scene, Error> {
     let mut opts = LoadOptions::from_env();
@@ -136,24 +154,7 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
     if args.spp == 0 {
         return Err(Error::Input("--spp must be at least 1".into()));
     }
-    if args.taps == 0 || args.taps > 1025 {
-        return Err(Error::Input(format!(
-            "--taps must lie in 1..=1025, got {}",
-            args.taps
-        )));
-    }
-    if !(0.0..=4.0).contains(&args.k) {
-        return Err(Error::Input(format!(
-            "--k must lie in [0, 4], got {}",
-            args.k
-        )));
-    }
-    if !(0.0..=1.0).contains(&args.jitter) {
-        return Err(Error::Input(format!(
-            "--jitter must lie in [0, 1], got {}",
-            args.jitter
-        )));
-    }
+    check_separable_args(args.taps, args.k, args.jitter)?;
     if args.threads == Some(0) {
         return Err(Error::Input("--threads must be at least 1".into()));
     }
