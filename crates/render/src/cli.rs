@@ -3,6 +3,7 @@
 //! (2 for bad input, 1 for failures while running); nothing is written to stdout then.
 
 use crate::Error;
+use crate::filter_cli::{FilterArgs, run_filter};
 use crate::kernel_cli::{KernelArgs, run_kernel};
 use crate::presets_table::presets_table;
 use crate::profile::{MediumSpec, ProfileModel, ProfileRequest, compute};
@@ -36,6 +37,8 @@ pub enum Command {
     Diff(DiffArgs),
     /// Export a separable screen-space kernel (JSON, CSV, GLSL or HLSL).
     Kernel(KernelArgs),
+    /// Run the screen-space separable pass on inputs read from an EXR file.
+    Filter(FilterArgs),
 }
 
 /// The medium of `sss profile` and `sss kernel`: a preset, or coefficients.
@@ -156,6 +159,7 @@ pub fn run(cli: &Cli, out: &mut dyn Write) -> Result<(), Error> {
         Command::Render(args) => run_render(args)?.into_bytes(),
         Command::Diff(args) => run_diff(args)?.into_bytes(),
         Command::Kernel(args) => run_kernel(args)?.into_bytes(),
+        Command::Filter(args) => run_filter(args)?.into_bytes(),
         Command::Profile(args) => {
             let req = args.request()?;
             if let Some(path) = &args.plot {
@@ -219,7 +223,7 @@ pub fn main(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
                     eprintln!(
-                        "error: a subcommand is required (profile, presets, render, diff or kernel); see `sss --help`"
+                        "error: a subcommand is required (profile, presets, render, diff, kernel or filter); see `sss --help`"
                     );
                     return ExitCode::from(2);
                 }

@@ -33,6 +33,7 @@
 pub mod camera;
 pub mod cli;
 mod error;
+pub mod filter_cli;
 pub mod gbuffer;
 pub mod geometry;
 pub mod image;

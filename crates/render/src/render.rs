@@ -103,6 +103,23 @@ pub struct RenderOutput {
     pub irradiance_samples: usize,
     /// Minimum spacing of the irradiance samples per object (object index, scene units).
     pub spacing: Vec<(u32, f64)>,
+    /// Separable integrator only: the screen-space buffers it filtered.
+    pub screen: Option<ScreenBuffers>,
+}
+
+/// The per-pixel inputs of a screen-space pass, in scene units: what `sss render --gbuffer`
+/// writes and `sss filter` reads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScreenBuffers {
+    /// Fresnel-transmitted, textured irradiance, averaged over the pixel's samples on its
+    /// object (0 off translucent objects).
+    pub irradiance: Vec<Rgb>,
+    /// Distance from the camera (scene units).
+    pub depth: Vec<f64>,
+    /// World-space size of one pixel at that distance (scene units).
+    pub footprint: Vec<f64>,
+    /// Translucent object per pixel (its first translucent sample's), `u32::MAX` for none.
+    pub object: Vec<u32>,
 }
 
 impl RenderOutput {
@@ -286,6 +303,7 @@ impl Prepared<'_> {
             stages: self.stages.clone(),
             irradiance_samples,
             spacing,
+            screen: None,
         }
     }
 }
@@ -487,6 +505,7 @@ fn render_separable(
     let t = Instant::now();
     let gb = &prep.gbuffer;
     let (w, h) = (gb.width as usize, gb.height as usize);
+    let screen = screen_buffers(prep, &irradiance);
     let mut values = vec![[0.0; 3]; gb.samples.len()];
     let opts = filter_options(&settings.separable, settings.seed);
     for (m, kernel) in kernels.iter().enumerate() {
@@ -499,26 +518,14 @@ fn render_separable(
         let mut mask = vec![NO_OBJECT; w * h];
         let mut mm = vec![0.0f32; w * h];
         for i in 0..w * h {
-            let mut count = 0.0;
-            let mut sum = [0.0; 3];
-            for k in gb.offsets[i] as usize..gb.offsets[i + 1] as usize {
-                let g = &gb.samples[k];
-                if scene.objects[g.object as usize].material != m {
-                    continue;
-                }
-                if count == 0.0 {
-                    mask[i] = g.object;
-                    depth[i] = (g.distance / u) as f32;
-                    mm[i] = (g.footprint / u) as f32;
-                }
-                for c in 0..3 {
-                    sum[c] += irradiance[k][c];
-                }
-                count += 1.0;
+            let o = screen.object[i];
+            if o == NO_OBJECT || scene.objects[o as usize].material != m {
+                continue;
             }
-            if count > 0.0 {
-                e[i] = sum.map(|v| (v / count) as f32);
-            }
+            mask[i] = o;
+            depth[i] = (screen.depth[i] / u) as f32;
+            mm[i] = (screen.footprint[i] / u) as f32;
+            e[i] = screen.irradiance[i].map(|v| v as f32);
         }
         let input = ScreenInput {
             width: w,
@@ -534,7 +541,9 @@ fn render_separable(
         }
         .map_err(|e| crate::Error::Input(format!("separable filter: {e}")))?;
         for (k, g) in gb.samples.iter().enumerate() {
-            if scene.objects[g.object as usize].material != m {
+            if scene.objects[g.object as usize].material != m
+                || screen.object[g.pixel as usize] != g.object
+            {
                 continue;
             }
             let f = filtered[g.pixel as usize];
@@ -549,5 +558,48 @@ fn render_separable(
         name: "shading",
         seconds: t.elapsed().as_secs_f64(),
     });
-    Ok(prep.assemble(&values, None, settings, 0, Vec::new()))
+    let mut out = prep.assemble(&values, None, settings, 0, Vec::new());
+    out.screen = Some(screen);
+    Ok(out)
+}
+
+/// Per pixel: the first translucent sample's object, and the average irradiance, depth and
+/// footprint of the pixel's samples on that object.
+fn screen_buffers(prep: &Prepared<'_>, irradiance: &[Rgb]) -> ScreenBuffers {
+    let gb = &prep.gbuffer;
+    let n = gb.pixels();
+    let mut b = ScreenBuffers {
+        irradiance: vec![[0.0; 3]; n],
+        depth: vec![0.0; n],
+        footprint: vec![0.0; n],
+        object: vec![u32::MAX; n],
+    };
+    for i in 0..n {
+        let range = gb.offsets[i] as usize..gb.offsets[i + 1] as usize;
+        let Some(first) = range
+            .clone()
+            .find(|&k| prep.shading_of(gb.samples[k].object).is_some())
+        else {
+            continue;
+        };
+        let o = gb.samples[first].object;
+        let mut count = 0.0;
+        for k in range {
+            let g = &gb.samples[k];
+            if g.object != o {
+                continue;
+            }
+            for c in 0..3 {
+                b.irradiance[i][c] += irradiance[k][c];
+            }
+            b.depth[i] += g.distance;
+            b.footprint[i] += g.footprint;
+            count += 1.0;
+        }
+        b.object[i] = o;
+        b.irradiance[i] = b.irradiance[i].map(|v| v / count);
+        b.depth[i] /= count;
+        b.footprint[i] /= count;
+    }
+    b
 }

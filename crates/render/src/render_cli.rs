@@ -72,6 +72,10 @@ pub struct RenderArgs {
     /// Tone-mapped sRGB PNG of the total.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
+    /// Separable: also write the screen-space inputs (layers `irradiance`, and `surface` =
+    /// depth, footprint in scene units and object id + 1, 0 for none) for `sss filter`.
+    #[arg(long, value_name = "FILE.exr")]
+    pub gbuffer: Option<PathBuf>,
 }
 
 /// Arguments of `sss diff`.
@@ -123,7 +127,8 @@ pub fn load_scene(name: &str, mesh_dirs: &[PathBuf]) -> Result<Scene, Error> {
     Ok(scene::load(path, &opts)?)
 }
 
-fn check_output(path: &Path, ext: &str) -> Result<(), Error> {
+/// Checks that `path` ends in `.ext` and that its directory is writable.
+pub fn check_output(path: &Path, ext: &str) -> Result<(), Error> {
     let ok = path
         .extension()
         .and_then(|e| e.to_str())
@@ -163,6 +168,12 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
     }
     if let Some(p) = &args.png {
         check_output(p, "png")?;
+    }
+    if let Some(p) = &args.gbuffer {
+        if args.method != MethodArg::Separable {
+            return Err(Error::Input("--gbuffer needs --method separable".into()));
+        }
+        check_output(p, "exr")?;
     }
     let scene = load_scene(&args.scene, &args.mesh_dir)?;
     for w in &scene.warnings {
@@ -219,6 +230,25 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
             out.height,
             &out.total,
             auto_exposure(&out.total),
+        )?;
+    }
+    if let (Some(p), Some(b)) = (&args.gbuffer, &out.screen) {
+        let surface: Vec<Rgb> = (0..b.depth.len())
+            .map(|i| {
+                // Object id + 1 (0: no translucent object); EXR values are kept non-negative.
+                let id = if b.object[i] == u32::MAX {
+                    0.0
+                } else {
+                    b.object[i] as f64 + 1.0
+                };
+                [b.depth[i], b.footprint[i], id]
+            })
+            .collect();
+        write_exr(
+            p,
+            out.width,
+            out.height,
+            &[("irradiance", &b.irradiance), ("surface", &surface)],
         )?;
     }
     Ok(summary(

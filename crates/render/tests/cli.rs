@@ -853,3 +853,97 @@ fn separable_render_is_close_to_exact() {
         assert!((r - 1.0).abs() < 0.1, "{d}");
     }
 }
+
+/// `sss render --method separable --gbuffer` writes the screen-space inputs and `sss filter`
+/// reproduces the render's pass from them: render = F_t(η, cos θ_o)/(cπ) × filter output, with
+/// F_t ≤ 1 and ≈ F_t(η, 1) at the pixel facing the camera.
+#[test]
+fn filter_reads_the_gbuffer_and_reproduces_the_pass() {
+    use sss_bssrdf::fresnel::ft_dielectric;
+    use sss_bssrdf::fresnel_normalization;
+    let dir = tmp_dir("filter");
+    let scene = tiny_scene(&dir);
+    let (gb, sep, fil) = (dir.join("g.exr"), dir.join("s.exr"), dir.join("f.exr"));
+    ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--method",
+        "separable",
+        "--gbuffer",
+        gb.to_str().unwrap(),
+        "--out",
+        sep.to_str().unwrap(),
+    ]);
+    let text = ok(&[
+        "filter",
+        gb.to_str().unwrap(),
+        "--preset",
+        "skin1",
+        "--units-per-mm",
+        "0.1",
+        "--out",
+        fil.to_str().unwrap(),
+    ]);
+    assert!(text.contains("translucent pixels"), "{text}");
+    let (_, _, s) = sss_render::image::read_exr(&sep).unwrap();
+    let (_, _, f) = sss_render::image::read_exr(&fil).unwrap();
+    let sub = &s.iter().find(|(n, _)| n == "subsurface").unwrap().1;
+    let ex = &f.iter().find(|(n, _)| n == "exitance").unwrap().1;
+    let norm = 1.0 / (fresnel_normalization(1.3) * std::f64::consts::PI);
+    let mut max_ratio: f64 = 0.0;
+    let mut lit = 0;
+    for i in 0..sub.len() {
+        for c in 0..3 {
+            if ex[i][c] <= 1e-12 {
+                assert!(
+                    sub[i][c] <= 1e-9,
+                    "pixel {i}: render {} without exitance",
+                    sub[i][c]
+                );
+                continue;
+            }
+            let r = sub[i][c] / (ex[i][c] * norm);
+            assert!(r <= 1.0 + 1e-4, "pixel {i} channel {c}: ratio {r}");
+            max_ratio = max_ratio.max(r);
+            lit += 1;
+        }
+    }
+    assert!(lit > 30, "{lit}");
+    let ft1 = ft_dielectric(1.0, 1.3);
+    assert!(
+        (max_ratio - ft1).abs() < 0.01,
+        "max ratio {max_ratio} vs F_t(1) {ft1}"
+    );
+    // Bad input: a file without the layers, and --gbuffer without the separable method.
+    let o = sss(&[
+        "filter",
+        sep.to_str().unwrap(),
+        "--preset",
+        "skin1",
+        "--units-per-mm",
+        "0.1",
+        "--out",
+        fil.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("irradiance"), "{}", stderr(&o));
+    let o = sss(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--gbuffer",
+        gb.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--method separable"), "{}", stderr(&o));
+    let o = sss(&[
+        "filter",
+        gb.to_str().unwrap(),
+        "--preset",
+        "skin1",
+        "--units-per-mm",
+        "0",
+        "--out",
+        fil.to_str().unwrap(),
+    ]);
+    assert!(stderr(&o).contains("--units-per-mm"), "{}", stderr(&o));
+}
