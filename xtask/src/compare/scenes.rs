@@ -63,7 +63,7 @@ pub fn reference_spacing(quick: bool) -> f64 {
 }
 
 /// The reference settings: `exact` at [`reference_spacing`].
-fn reference_settings(seed: u64, quick: bool) -> RenderSettings {
+pub(super) fn reference_settings(seed: u64, quick: bool) -> RenderSettings {
     RenderSettings {
         method: Method::Exact,
         seed,
@@ -260,9 +260,9 @@ fn csv_rows(runs: &[Run]) -> String {
 /// The scenes of a run: names of built-in scenes or paths to scene files. Scenes whose mesh is
 /// missing are skipped with a message.
 /// Loaded scenes with their TOML text (the reference cache key), and skip messages.
-type LoadedScenes = (Vec<(Scene, String)>, Vec<String>);
+pub(super) type LoadedScenes = (Vec<(Scene, String)>, Vec<String>);
 
-fn load_scenes(ctx: &Context<'_>) -> Result<LoadedScenes, Error> {
+pub(super) fn load_scenes(ctx: &Context<'_>) -> Result<LoadedScenes, Error> {
     let cfg = ctx.config;
     let opts = LoadOptions {
         mesh_dirs: cfg.mesh_dirs.clone(),
@@ -313,15 +313,15 @@ fn fnv(bytes: &[u8]) -> u64 {
 }
 
 /// The cached reference of a scene: its subsurface image, coverage and timing.
-struct Reference {
-    subsurface: Vec<Rgb>,
+pub(super) struct Reference {
+    pub(super) subsurface: Vec<Rgb>,
     total: Vec<Rgb>,
-    coverage: Vec<f32>,
+    pub(super) coverage: Vec<f32>,
     seconds: f64,
     samples: usize,
 }
 
-fn reference(ctx: &Context<'_>, scene: &Scene, text: &str) -> Result<Reference, Error> {
+pub(super) fn reference(ctx: &Context<'_>, scene: &Scene, text: &str) -> Result<Reference, Error> {
     let cfg = ctx.config;
     let key = fnv(format!(
         "v{REFERENCE_VERSION}|{text}|{}x{}|{}|{:?}",
