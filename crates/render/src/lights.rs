@@ -45,7 +45,6 @@ pub fn gather(
 ) {
     let Receiver { p, n, ng } = at;
     let m = area_samples.max(1);
-    let eps = geom.epsilon();
     for light in lights {
         match light {
             Light::Point {
@@ -63,8 +62,7 @@ pub fn gather(
                 if !(cos > 0.0) || ng.dot(wi) <= 0.0 {
                     continue;
                 }
-                let o = geom.offset(p, ng, wi);
-                if geom.occluded(o, wi, 0.0, (dist - 4.0 * eps).max(0.0)) {
+                if !unblocked(geom, p, ng, wi, dist) {
                     continue;
                 }
                 let s = cos / dist2;
@@ -79,8 +77,7 @@ pub fn gather(
                 if !(cos > 0.0) || ng.dot(wi) <= 0.0 {
                     continue;
                 }
-                let o = geom.offset(p, ng, wi);
-                if geom.occluded(o, wi, 0.0, f64::INFINITY) {
+                if !unblocked(geom, p, ng, wi, f64::INFINITY) {
                     continue;
                 }
                 push(out, wi, irradiance.map(|v| v * cos));
@@ -112,8 +109,7 @@ pub fn gather(
                     if !(cos > 0.0) || !(cos_l > 0.0) || ng.dot(wi) <= 0.0 {
                         continue;
                     }
-                    let o = geom.offset(p, ng, wi);
-                    if geom.occluded(o, wi, 0.0, (dist - 4.0 * eps).max(0.0)) {
+                    if !unblocked(geom, p, ng, wi, dist) {
                         continue;
                     }
                     // L cos dω / pdf with pdf = 1/area over the quad and dω = cos_l dA / d².
@@ -133,8 +129,7 @@ pub fn gather(
                     if ng.dot(wi) <= 0.0 {
                         continue;
                     }
-                    let o = geom.offset(p, ng, wi);
-                    if geom.occluded(o, wi, 0.0, f64::INFINITY) {
+                    if !unblocked(geom, p, ng, wi, f64::INFINITY) {
                         continue;
                     }
                     let s = PI / m as f64;
@@ -143,6 +138,18 @@ pub fn gather(
             }
         }
     }
+}
+
+/// Whether nothing blocks the way from `p` (leaving on `ng`'s side of the surface towards
+/// `wi`) to a light at distance `dist` (infinite for distant lights and the environment).
+fn unblocked(geom: &SceneGeometry, p: DVec3, ng: DVec3, wi: DVec3, dist: f64) -> bool {
+    let o = geom.offset(p, ng, wi);
+    let t_max = if dist.is_finite() {
+        (dist - 4.0 * geom.epsilon()).max(0.0)
+    } else {
+        f64::INFINITY
+    };
+    !geom.occluded(o, wi, 0.0, t_max)
 }
 
 fn push(out: &mut Vec<Incident>, dir: DVec3, e_cos: Rgb) {
