@@ -7,11 +7,9 @@
 use crate::Error;
 use crate::cli::MediumArgs;
 use crate::image::{auto_exposure, read_exr, write_exr, write_png};
-use crate::integrators::separable::{
-    KernelMethod, MaterialKernel, SeparableSettings, build_kernel, filter_options,
-};
+use crate::integrators::separable::{MaterialKernel, build_kernel, filter_options};
 use crate::profile::build_medium;
-use crate::render_cli::{check_output, check_separable_args};
+use crate::render_cli::{SeparableArgs, check_output};
 use clap::Args;
 use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
@@ -31,21 +29,9 @@ pub struct FilterArgs {
     /// The BSSRDF model whose R_d the kernel approximates.
     #[arg(long, default_value = "better-dipole")]
     pub model: ModelKind,
-    /// The kernel (or exact2d for the full 2D convolution).
-    #[arg(long, default_value = "preintegrated")]
-    pub kernel: KernelMethod,
-    /// Taps per 1D pass.
-    #[arg(long, default_value_t = 7)]
-    pub taps: usize,
-    /// Place taps uniformly instead of by importance.
-    #[arg(long)]
-    pub uniform_taps: bool,
-    /// Guided-optimisation exponent k in [0, 4].
-    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
-    pub k: f64,
-    /// Rotation jitter radius (fraction of the kernel support; 0 = off).
-    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
-    pub jitter: f32,
+    /// The kernel and filter options.
+    #[command(flatten)]
+    pub separable: SeparableArgs,
     /// Seed of the per-pixel rotations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -59,7 +45,7 @@ pub struct FilterArgs {
 
 /// Runs `sss filter`; returns a one-line summary.
 pub fn run_filter(args: &FilterArgs) -> Result<String, Error> {
-    check_separable_args(args.taps, args.k, args.jitter)?;
+    let settings = args.separable.settings()?;
     if !(args.units_per_mm.is_finite() && args.units_per_mm > 0.0) {
         return Err(Error::Input(format!(
             "--units-per-mm must be positive, got {}",
@@ -94,15 +80,8 @@ pub fn run_filter(args: &FilterArgs) -> Result<String, Error> {
             e[i] = irr[i].map(|v| v as f32);
         }
     }
-    let settings = SeparableSettings {
-        kernel: args.kernel,
-        taps: args.taps,
-        importance: !args.uniform_taps,
-        k: args.k,
-        jitter: args.jitter,
-    };
     let kernel = build_kernel(model.as_ref(), &settings)
-        .map_err(|e| Error::Input(format!("cannot build the {} kernel: {e}", args.kernel)))?;
+        .map_err(|e| Error::Input(format!("cannot build the {} kernel: {e}", settings.kernel)))?;
     let input = ScreenInput {
         width: w as usize,
         height: h as usize,
@@ -127,6 +106,6 @@ pub fn run_filter(args: &FilterArgs) -> Result<String, Error> {
     let covered = mask.iter().filter(|m| **m != NO_OBJECT).count();
     Ok(format!(
         "filtered {w}x{h} ({covered} translucent pixels) with the {} kernel in {seconds:.4} s\n",
-        args.kernel
+        settings.kernel
     ))
 }

@@ -34,23 +34,9 @@ pub struct RenderArgs {
     /// Path tracer: BSSRDF samples per pixel sample.
     #[arg(long, default_value_t = 16)]
     pub spp: u32,
-    /// Separable: the kernel (preintegrated, svd1, svd3, svd6, artist, guided, gaussians1,
-    /// gaussians6, or exact2d for the brute-force 2D screen-space convolution).
-    #[arg(long, default_value = "preintegrated")]
-    pub kernel: KernelMethod,
-    /// Separable: taps per 1D pass.
-    #[arg(long, default_value_t = 7)]
-    pub taps: usize,
-    /// Separable: place taps uniformly instead of by importance.
-    #[arg(long)]
-    pub uniform_taps: bool,
-    /// Separable: guided-optimisation exponent k in [0, 4].
-    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
-    pub k: f64,
-    /// Separable: fraction of the kernel support within which the filter axes are rotated per
-    /// pixel (0 turns the jitter off).
-    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
-    pub jitter: f32,
+    /// The separable integrator's kernel and filter.
+    #[command(flatten)]
+    pub separable: SeparableArgs,
     /// Seed of every random choice (same seed, same image).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -96,7 +82,43 @@ pub struct DiffArgs {
     pub eps: f64,
 }
 
-/// Checks the separable options shared by `sss render` and `sss kernel`.
+/// The separable kernel and filter options of `sss render` and `sss filter`.
+#[derive(Debug, Args)]
+pub struct SeparableArgs {
+    /// Separable: the kernel (preintegrated, svd1, svd3, svd6, artist, guided, gaussians1,
+    /// gaussians6, or exact2d for the brute-force 2D screen-space convolution).
+    #[arg(long, default_value = "preintegrated")]
+    pub kernel: KernelMethod,
+    /// Separable: taps per 1D pass.
+    #[arg(long, default_value_t = 7)]
+    pub taps: usize,
+    /// Separable: place taps uniformly instead of by importance.
+    #[arg(long)]
+    pub uniform_taps: bool,
+    /// Separable: guided-optimisation exponent k in [0, 4].
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    pub k: f64,
+    /// Separable: fraction of the kernel support within which the filter axes are rotated per
+    /// pixel (0 turns the jitter off).
+    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
+    pub jitter: f32,
+}
+
+impl SeparableArgs {
+    /// The checked settings these options describe.
+    pub fn settings(&self) -> Result<SeparableSettings, Error> {
+        check_separable_args(self.taps, self.k, self.jitter)?;
+        Ok(SeparableSettings {
+            kernel: self.kernel,
+            taps: self.taps,
+            importance: !self.uniform_taps,
+            k: self.k,
+            jitter: self.jitter,
+        })
+    }
+}
+
+/// Checks the separable options shared by `sss render`, `sss filter` and `sss kernel`.
 pub fn check_separable_args(taps: usize, k: f64, jitter: f32) -> Result<(), Error> {
     if taps == 0 || taps > 1025 {
         return Err(Error::Input(format!(
@@ -159,7 +181,7 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
     if args.spp == 0 {
         return Err(Error::Input("--spp must be at least 1".into()));
     }
-    check_separable_args(args.taps, args.k, args.jitter)?;
+    let separable = args.separable.settings()?;
     if args.threads == Some(0) {
         return Err(Error::Input("--threads must be at least 1".into()));
     }
@@ -185,13 +207,7 @@ pub fn run_render(args: &RenderArgs) -> Result<String, Error> {
             MethodArg::Pathtrace => Method::PathTrace,
             MethodArg::Separable => Method::Separable,
         },
-        separable: SeparableSettings {
-            kernel: args.kernel,
-            taps: args.taps,
-            importance: !args.uniform_taps,
-            k: args.k,
-            jitter: args.jitter,
-        },
+        separable,
         spp: args.spp,
         seed: args.seed,
         irradiance: IrradianceSettings {
