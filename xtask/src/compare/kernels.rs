@@ -150,12 +150,17 @@ fn world_space(ctx: &Context<'_>) -> Result<Vec<Vec<String>>, Error> {
     use super::scenes::{load_scenes, reference, reference_settings};
     use sss_render::render::{Method, render};
     use sss_render::render_cli::error_figures;
-    let (scenes, _) = load_scenes(ctx)?;
-    let mut rows = Vec::new();
-    for (scene, text) in scenes
+    // Only the two scenes whose materials the table is about, if the run includes them.
+    let names: Vec<String> = ctx
+        .config
+        .scenes
         .iter()
-        .filter(|(s, _)| s.name == "sphere" || s.name == "slab")
-    {
+        .filter(|n| *n == "sphere" || *n == "slab")
+        .cloned()
+        .collect();
+    let (scenes, _) = load_scenes(ctx, &names)?;
+    let mut rows = Vec::new();
+    for (scene, text) in &scenes {
         let r = reference(ctx, scene, text)?;
         let pixels: Vec<usize> = (0..r.coverage.len())
             .filter(|&i| r.coverage[i] > 0.0)

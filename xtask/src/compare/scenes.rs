@@ -75,21 +75,26 @@ pub(super) fn reference_settings(seed: u64, quick: bool) -> RenderSettings {
     }
 }
 
-/// `exact` with coarser irradiance samples: how error grows as the samples thin out.
-struct ExactSpacing;
+/// A method that renders with the reference's settings changed by one swept parameter: the
+/// shape of every method registered so far.
+struct Sweep {
+    name: &'static str,
+    param: &'static str,
+    /// Parameter values, cheapest first (the argument is `--quick`).
+    values: fn(bool) -> Vec<f64>,
+    /// The reference's settings with the parameter set to a value.
+    settings: fn(&RenderSettings, f64) -> RenderSettings,
+}
 
-impl SceneMethod for ExactSpacing {
+impl SceneMethod for Sweep {
     fn name(&self) -> &'static str {
-        "exact"
+        self.name
     }
     fn param(&self) -> &'static str {
-        "spacing_mfp"
+        self.param
     }
     fn values(&self, quick: bool) -> Vec<f64> {
-        // Coarser than the reference, by factors 8, 4, 2 (4, 2 with --quick).
-        let r = reference_spacing(quick);
-        let factors: &[f64] = if quick { &[4.0, 2.0] } else { &[8.0, 4.0, 2.0] };
-        factors.iter().map(|f| f * r).collect()
+        (self.values)(quick)
     }
     fn run(
         &self,
@@ -97,91 +102,71 @@ impl SceneMethod for ExactSpacing {
         value: f64,
         base: &RenderSettings,
     ) -> Result<RenderOutput, sss_render::Error> {
-        let s = RenderSettings {
-            irradiance: IrradianceSettings {
-                spacing_mfp: value,
-                ..base.irradiance
-            },
-            ..base.clone()
-        };
-        render(scene, &s, None)
+        render(scene, &(self.settings)(base, value), None)
     }
 }
 
-/// The BSSRDF-importance-sampled path tracer at growing sample counts.
-struct PathTrace;
-
-impl SceneMethod for PathTrace {
-    fn name(&self) -> &'static str {
-        "pathtrace"
-    }
-    fn param(&self) -> &'static str {
-        "spp"
-    }
-    fn values(&self, quick: bool) -> Vec<f64> {
-        if quick {
-            vec![1.0, 4.0, 16.0]
-        } else {
-            vec![1.0, 4.0, 16.0, 64.0]
-        }
-    }
-    fn run(
-        &self,
-        scene: &Scene,
-        value: f64,
-        base: &RenderSettings,
-    ) -> Result<RenderOutput, sss_render::Error> {
-        let s = RenderSettings {
-            method: Method::PathTrace,
-            spp: value as u32,
-            ..base.clone()
-        };
-        render(scene, &s, None)
-    }
-}
-
-/// The screen-space separable blur (Jimenez et al. 2015) with the pre-integrated kernel and
-/// importance-sampled taps, at growing tap counts.
-struct Separable;
-
-impl SceneMethod for Separable {
-    fn name(&self) -> &'static str {
-        "separable"
-    }
-    fn param(&self) -> &'static str {
-        "taps"
-    }
-    fn values(&self, quick: bool) -> Vec<f64> {
-        if quick {
-            vec![3.0, 7.0, 15.0]
-        } else {
-            vec![3.0, 7.0, 15.0, 31.0]
-        }
-    }
-    fn run(
-        &self,
-        scene: &Scene,
-        value: f64,
-        base: &RenderSettings,
-    ) -> Result<RenderOutput, sss_render::Error> {
-        let s = RenderSettings {
-            method: Method::Separable,
-            separable: SeparableSettings {
-                taps: value as usize,
-                ..SeparableSettings::default()
-            },
-            ..base.clone()
-        };
-        render(scene, &s, None)
-    }
-}
-
-/// Every registered rendering method (later issues add theirs here).
+/// Every registered rendering method (later issues add theirs here):
+/// - `exact` with coarser irradiance samples (spacing ×8, ×4, ×2 of the reference's; ×4, ×2
+///   with `--quick`): how error grows as the samples thin out;
+/// - the BSSRDF-importance-sampled path tracer at growing sample counts;
+/// - the screen-space separable blur (Jimenez et al. 2015) with the pre-integrated kernel and
+///   importance-sampled taps, at growing tap counts.
 pub fn methods() -> Vec<Box<dyn SceneMethod>> {
     vec![
-        Box::new(ExactSpacing),
-        Box::new(PathTrace),
-        Box::new(Separable),
+        Box::new(Sweep {
+            name: "exact",
+            param: "spacing_mfp",
+            values: |quick| {
+                let factors: &[f64] = if quick { &[4.0, 2.0] } else { &[8.0, 4.0, 2.0] };
+                factors
+                    .iter()
+                    .map(|f| f * reference_spacing(quick))
+                    .collect()
+            },
+            settings: |base, value| RenderSettings {
+                irradiance: IrradianceSettings {
+                    spacing_mfp: value,
+                    ..base.irradiance
+                },
+                ..base.clone()
+            },
+        }),
+        Box::new(Sweep {
+            name: "pathtrace",
+            param: "spp",
+            values: |quick| {
+                if quick {
+                    vec![1.0, 4.0, 16.0]
+                } else {
+                    vec![1.0, 4.0, 16.0, 64.0]
+                }
+            },
+            settings: |base, value| RenderSettings {
+                method: Method::PathTrace,
+                spp: value as u32,
+                ..base.clone()
+            },
+        }),
+        Box::new(Sweep {
+            name: "separable",
+            param: "taps",
+            values: |quick| {
+                if quick {
+                    vec![3.0, 7.0, 15.0]
+                } else {
+                    vec![3.0, 7.0, 15.0, 31.0]
+                }
+            },
+            settings: |base, value| RenderSettings {
+                method: Method::Separable,
+                separable: SeparableSettings {
+                    taps: value as usize,
+                    ..SeparableSettings::default()
+                },
+                ..base.clone()
+            },
+        }),
     ]
 }
 
@@ -262,14 +247,14 @@ fn csv_rows(runs: &[Run]) -> String {
 /// Loaded scenes with their TOML text (the reference cache key), and skip messages.
 pub(super) type LoadedScenes = (Vec<(Scene, String)>, Vec<String>);
 
-pub(super) fn load_scenes(ctx: &Context<'_>) -> Result<LoadedScenes, Error> {
+pub(super) fn load_scenes(ctx: &Context<'_>, names: &[String]) -> Result<LoadedScenes, Error> {
     let cfg = ctx.config;
     let opts = LoadOptions {
         mesh_dirs: cfg.mesh_dirs.clone(),
     };
     let mut out = Vec::new();
     let mut skipped = Vec::new();
-    for name in &cfg.scenes {
+    for name in names {
         let path = Path::new(name);
         let (loaded, text) =
             if !path.exists() && scene::BUILTIN_SCENES.iter().any(|(n, _)| n == name) {
@@ -487,7 +472,7 @@ impl Experiment for SceneComparison {
 
     fn run(&self, ctx: &Context<'_>) -> Result<Section, Error> {
         let cfg = ctx.config;
-        let (scenes, skipped) = load_scenes(ctx)?;
+        let (scenes, skipped) = load_scenes(ctx, &cfg.scenes)?;
         let all_threads = rayon::current_num_threads();
         let mut thread_counts = vec![all_threads];
         if all_threads > 1 {
