@@ -263,7 +263,8 @@ impl Prepared<'_> {
                 let mut covered = 0u32;
                 for k in lo..hi {
                     let g = &gb.samples[k];
-                    let v = if this.shading_of(g.object).is_some() {
+                    let translucent = this.shading_of(g.object).is_some();
+                    let v = if translucent {
                         covered += 1;
                         subsurface[k]
                     } else {
@@ -276,7 +277,7 @@ impl Prepared<'_> {
                             0.0
                         };
                         total[c] += v / spp;
-                        if this.shading_of(g.object).is_some() {
+                        if translucent {
                             sss[c] += v / spp;
                         }
                     }

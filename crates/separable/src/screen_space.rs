@@ -168,6 +168,20 @@ fn floor_i32(x: f32) -> i32 {
     i - ((i as f32) > x) as i32
 }
 
+/// The four texels (indices into a row-major image of width `w`, clamped to the edges
+/// `wmax`, `hmax`) and the bilinear fractions (fx, fy) of the point (sx, sy).
+#[inline(always)]
+fn bilinear_cell(sx: f32, sy: f32, w: usize, wmax: i32, hmax: i32) -> ([usize; 4], f32, f32) {
+    let (x0, y0) = (floor_i32(sx), floor_i32(sy));
+    let (fx, fy) = (sx - x0 as f32, sy - y0 as f32);
+    let (cx0, cx1) = (x0.clamp(0, wmax) as usize, (x0 + 1).clamp(0, wmax) as usize);
+    let (cy0, cy1) = (
+        y0.clamp(0, hmax) as usize * w,
+        (y0 + 1).clamp(0, hmax) as usize * w,
+    );
+    ([cy0 + cx0, cy0 + cx1, cy1 + cx0, cy1 + cx1], fx, fy)
+}
+
 /// The per-pixel rules shared by the separable pass and the exact 2D convolution.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Rules {
@@ -313,17 +327,11 @@ impl Pass<'_> {
             if self.jitter && o_mm.abs() <= self.rotate_limit_mm {
                 // Rotated axis: bilinear fetch at p − o·dir.
                 let (sx, sy) = (x as f32 - o * rdx, y as f32 - o * rdy);
-                let (x0, y0) = (floor_i32(sx), floor_i32(sy));
-                let (fx, fy) = (sx - x0 as f32, sy - y0 as f32);
-                let (cx0, cx1) = (x0.clamp(0, wmax) as usize, (x0 + 1).clamp(0, wmax) as usize);
-                let (cy0, cy1) = (
-                    y0.clamp(0, hmax) as usize * w,
-                    (y0 + 1).clamp(0, hmax) as usize * w,
-                );
-                self.texel(cy0 + cx0, (1.0 - fx) * (1.0 - fy), wt, id, d0, &mut a);
-                self.texel(cy0 + cx1, fx * (1.0 - fy), wt, id, d0, &mut a);
-                self.texel(cy1 + cx0, (1.0 - fx) * fy, wt, id, d0, &mut a);
-                self.texel(cy1 + cx1, fx * fy, wt, id, d0, &mut a);
+                let ([j00, j01, j10, j11], fx, fy) = bilinear_cell(sx, sy, w, wmax, hmax);
+                self.texel(j00, (1.0 - fx) * (1.0 - fy), wt, id, d0, &mut a);
+                self.texel(j01, fx * (1.0 - fy), wt, id, d0, &mut a);
+                self.texel(j10, (1.0 - fx) * fy, wt, id, d0, &mut a);
+                self.texel(j11, fx * fy, wt, id, d0, &mut a);
             } else {
                 // Axis-aligned: linear fetch along the pass's axis.
                 let (p, stride, lim, base) = if self.vertical {
@@ -380,14 +388,7 @@ impl Pass<'_> {
                 centre
             } else if JITTER && o_mm.abs() <= self.rotate_limit_mm {
                 let (sx, sy) = (x as f32 - o * rdx, y as f32 - o * rdy);
-                let (x0, y0) = (floor_i32(sx), floor_i32(sy));
-                let (fx, fy) = (sx - x0 as f32, sy - y0 as f32);
-                let (cx0, cx1) = (x0.clamp(0, wmax) as usize, (x0 + 1).clamp(0, wmax) as usize);
-                let (cy0, cy1) = (
-                    y0.clamp(0, hmax) as usize * w,
-                    (y0 + 1).clamp(0, hmax) as usize * w,
-                );
-                let (j00, j01, j10, j11) = (cy0 + cx0, cy0 + cx1, cy1 + cx0, cy1 + cx1);
+                let ([j00, j01, j10, j11], fx, fy) = bilinear_cell(sx, sy, w, wmax, hmax);
                 if !(kept(j00) && kept(j01) && kept(j10) && kept(j11)) {
                     return None;
                 }
