@@ -1,7 +1,7 @@
 //! The pinhole camera: primary rays and pixel-sample positions.
 
 use crate::rng::{Stream, rng};
-use crate::scene::Camera;
+use sss_scene::Camera;
 use glam::DVec3;
 use rand::RngExt;
 

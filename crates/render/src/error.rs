@@ -1,7 +1,7 @@
 //! The crate's error type.
 
 use crate::plot::PlotError;
-use crate::scene::{SceneError, SceneErrorKind};
+use sss_scene::{SceneError, SceneErrorKind};
 use sss_bssrdf::BssrdfError;
 use std::fmt;
 

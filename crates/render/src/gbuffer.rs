@@ -4,7 +4,7 @@
 
 use crate::camera::{CameraFrame, pixel_samples};
 use crate::geometry::SceneGeometry;
-use crate::scene::Scene;
+use sss_scene::Scene;
 use glam::DVec3;
 use rayon::prelude::*;
 

@@ -2,7 +2,7 @@
 //! rays of the BSSRDF sampler can be limited to their own object and the scene is only a short
 //! list of per-object BVHs with bounding boxes.
 
-use crate::scene::{Mesh, Scene};
+use sss_scene::{Mesh, Scene};
 use glam::DVec3;
 use sss_hierarchy::TriangleBvh;
 

@@ -11,7 +11,7 @@
 use crate::geometry::{SceneGeometry, triangles_of};
 use crate::lights::{Incident, Receiver, gather};
 use crate::rng::{Stream, rng};
-use crate::scene::Scene;
+use sss_scene::Scene;
 use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::fresnel::ft_dielectric;

@@ -48,6 +48,7 @@ pub mod progress;
 pub mod render;
 pub mod render_cli;
 pub mod rng;
-pub mod scene;
 
 pub use error::Error;
+/// The scene format (re-exported from `sss-scene`).
+pub use sss_scene as scene;

@@ -3,7 +3,7 @@
 //! opaque ones.
 
 use crate::geometry::SceneGeometry;
-use crate::scene::Light;
+use sss_scene::Light;
 use glam::DVec3;
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;

@@ -12,7 +12,7 @@ use crate::integrators::{TranslucentShading, exact, shading_for};
 use crate::irradiance::{self, IrradianceSettings, ObjectSamples};
 use crate::lights::{Receiver, background, gather};
 use crate::rng::{Stream, rng};
-use crate::scene::{MaterialKind, Scene};
+use sss_scene::{MaterialKind, Scene};
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;

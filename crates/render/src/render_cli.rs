@@ -4,7 +4,7 @@ use crate::image::{auto_exposure, read_exr, write_error_map, write_exr, write_pn
 use crate::integrators::separable::{KernelMethod, SeparableSettings};
 use crate::irradiance::IrradianceSettings;
 use crate::render::{Method, RenderOutput, RenderSettings, render};
-use crate::scene::{self, LoadOptions, Scene};
+use sss_scene::{self as scene, LoadOptions, Scene};
 use crate::{Error, progress};
 use clap::{Args, ValueEnum};
 use sss_bssrdf::Rgb;

@@ -9,7 +9,7 @@ pub mod exact;
 pub mod pathtrace;
 pub mod separable;
 
-use crate::scene::{Scene, Texture, Translucent};
+use sss_scene::{Scene, Texture, Translucent};
 use sss_bssrdf::{Bssrdf, ModelKind, Rgb, fresnel_normalization, make_model};
 use std::f64::consts::PI;
 

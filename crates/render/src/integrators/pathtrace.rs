@@ -21,7 +21,7 @@ use super::TranslucentShading;
 use crate::gbuffer::GSample;
 use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::lights::{Incident, Receiver, gather, tangent_frame};
-use crate::scene::Light;
+use sss_scene::Light;
 use glam::DVec3;
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;

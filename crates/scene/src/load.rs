@@ -48,12 +48,12 @@ impl LoadOptions {
 /// The scenes embedded in the repository: (name, TOML text of `scenes/NAME.toml`). See
 /// `scenes/README.md` for what each one tests.
 pub const BUILTIN_SCENES: &[(&str, &str)] = &[
-    ("sphere", include_str!("../../../../scenes/sphere.toml")),
-    ("toad", include_str!("../../../../scenes/toad.toml")),
-    ("picnic", include_str!("../../../../scenes/picnic.toml")),
-    ("backlit", include_str!("../../../../scenes/backlit.toml")),
-    ("slab", include_str!("../../../../scenes/slab.toml")),
-    ("bunny", include_str!("../../../../scenes/bunny.toml")),
+    ("sphere", include_str!("../builtin/sphere.toml")),
+    ("toad", include_str!("../builtin/toad.toml")),
+    ("picnic", include_str!("../builtin/picnic.toml")),
+    ("backlit", include_str!("../builtin/backlit.toml")),
+    ("slab", include_str!("../builtin/slab.toml")),
+    ("bunny", include_str!("../builtin/bunny.toml")),
 ];
 
 /// Loads a scene file. Relative mesh paths are resolved against the file's directory first,

@@ -1,13 +1,35 @@
-//! Scenes: what a scene file describes, after loading and validation.
+//! # sss-scene: the scene format of the subsurface-scattering toolkit
+//!
+//! Parses, loads and validates scene files without the renderer: use it to check a scene, to
+//! write a tool that reads our scenes, or as the input stage of your own renderer. The renderer
+//! (`sss-render`) takes the [`Scene`] this crate produces.
 //!
 //! A [`Scene`] is plain data in world space: a pinhole [`Camera`], [`Light`]s, [`Material`]s and
 //! [`Object`]s whose triangle meshes are already transformed, cleaned (degenerate triangles
 //! dropped and counted) and given per-vertex shading normals. The file format (TOML) is
-//! documented in `scenes/README.md`; [`load`] reads it, [`builtin`] returns the scenes embedded
-//! in the repository.
+//! documented in `scenes/README.md`; [`load`] reads it, [`load_str`] parses text, [`builtin`]
+//! returns the scenes embedded in the crate. Every problem is a [`SceneError`] naming the file,
+//! the line and the key; loading never panics on bad input.
 //!
 //! Units: lengths in scene units; each translucent material says how many scene units make a
 //! millimetre ([`Translucent::units_per_mm`]), since the models work in mm.
+//!
+//! ```
+//! use sss_scene::{LoadOptions, builtin, load_str};
+//!
+//! let scene = builtin("sphere", &LoadOptions::default())?;
+//! assert!((0..scene.objects.len()).any(|o| scene.translucent(o).is_some()));
+//!
+//! // A malformed file is an error naming the problem, never a panic.
+//! let err = load_str("[camera]\nresolution = [0, 10]\n", "bad.toml", None, &LoadOptions::default())
+//!     .unwrap_err();
+//! assert!(err.to_string().contains("bad.toml"));
+//! # Ok::<(), sss_scene::SceneError>(())
+//! ```
+//!
+//! ## Papers
+//! None of its own; the bumpy-sphere displacement and noise textures use Perlin's improved noise
+//! (Perlin 2002), the material presets come from Jensen et al. 2001 (via `sss-bssrdf`).
 
 mod format;
 mod load;

@@ -1,13 +1,13 @@
 //! Wavefront OBJ meshes: a line-by-line check that names the line of a bad vertex or face
 //! (tobj reports neither), then tobj for the geometry.
 
-use super::super::shapes::{RawMesh, is_closed, signed_volume};
-use super::super::{SceneError, SceneErrorKind};
+use crate::shapes::{RawMesh, is_closed, signed_volume};
+use crate::{SceneError, SceneErrorKind};
 use glam::DVec3;
 use std::collections::HashMap;
 
 /// A mesh read from an OBJ file, in the file's coordinates.
-pub(in super::super) struct ObjMesh {
+pub(crate) struct ObjMesh {
     /// Positions, triangles (fans of the polygons) and, if the file has `vn` for every face
     /// corner, one normal per vertex (positions are split where a position has several).
     pub raw: RawMesh,
@@ -133,7 +133,7 @@ fn check_lines(file: &str, text: &str) -> Result<bool, SceneError> {
 /// geometry with tobj (polygons fanned into triangles, all groups and objects merged into one
 /// mesh, materials ignored), keeps `vn` normals when every face corner has one, and reverses
 /// the winding of a closed mesh whose signed volume is negative.
-pub(in super::super) fn parse(file: &str, bytes: &[u8]) -> Result<ObjMesh, SceneError> {
+pub(crate) fn parse(file: &str, bytes: &[u8]) -> Result<ObjMesh, SceneError> {
     let text = String::from_utf8_lossy(bytes);
     let normals_everywhere = check_lines(file, &text)?;
     // `..Default::default()` covers the fields tobj's optional features add (`merging`,

@@ -92,16 +92,11 @@ fn fade(t: f64) -> f64 {
     t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
 }
 
-/// SplitMix64's output function (Steele et al. 2014).
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// The lattice value at an integer point, uniform in [0, 1).
+/// The lattice value at an integer point, uniform in [0, 1): SplitMix64's output function
+/// (Steele et al. 2014) chained over the seed and the three coordinates.
 fn lattice(seed: u64, x: i64, y: i64, z: i64) -> f64 {
-    let mut h = mix64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
+    use sss_util::splitmix64_mix as mix64;
+    let mut h = sss_util::splitmix64(seed);
     h = mix64(h ^ x as u64);
     h = mix64(h.wrapping_add(0x632b_e59b_d9b4_e019) ^ y as u64);
     h = mix64(h.wrapping_add(0x8cb9_2ba7_2f3d_8dd7) ^ z as u64);
