@@ -4,7 +4,7 @@
 use sss_bssrdf::monte_carlo::{self, McConfig};
 use sss_bssrdf::presets::PRESETS;
 use sss_bssrdf::{Medium, ModelKind};
-use sss_render::profile::{MediumSpec, ProfileModel, ProfileRequest, compute};
+use sss_cli::profile_table::{MediumSpec, ProfileModel, ProfileRequest, compute};
 use std::path::PathBuf;
 
 const MODELS: [ProfileModel; 4] = [

@@ -60,6 +60,7 @@ use crate::{BssrdfError, DVec3, Medium, Rgb};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
+use sss_util::splitmix64;
 use std::sync::Mutex;
 
 /// Photons per chunk: the unit of parallel work and of RNG seeding.
@@ -298,15 +299,9 @@ impl PhotonScratch {
     }
 }
 
-/// splitmix64 finaliser (Steele, Lea, Flood, *Fast splittable pseudorandom number generators*,
-/// OOPSLA 2014): a bijective mixer with full avalanche.
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
+/// The seed of one chunk of one channel: (seed, channel, chunk) hashed through
+/// [`splitmix64`] (Steele, Lea, Flood, *Fast splittable pseudorandom number generators*,
+/// OOPSLA 2014), a bijective mixer with full avalanche.
 fn chunk_seed(seed: u64, channel: usize, chunk: u64) -> u64 {
     let h = splitmix64(seed);
     let h = splitmix64(h ^ (channel as u64 + 1).wrapping_mul(0xD6E8_FEB8_6659_FD93));

@@ -1,9 +1,9 @@
 //! The pinhole camera: primary rays and pixel-sample positions.
 
 use crate::rng::{Stream, rng};
-use sss_scene::Camera;
 use glam::DVec3;
 use rand::RngExt;
+use sss_scene::Camera;
 
 /// An orthonormal camera frame ready to generate rays.
 #[derive(Clone, Debug)]

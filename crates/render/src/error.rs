@@ -1,8 +1,7 @@
 //! The crate's error type.
 
-use crate::plot::PlotError;
-use sss_scene::{SceneError, SceneErrorKind};
 use sss_bssrdf::BssrdfError;
+use sss_scene::{SceneError, SceneErrorKind};
 use std::fmt;
 
 /// Everything the command-line tool and the library around it report.
@@ -14,8 +13,6 @@ pub enum Error {
     Input(String),
     /// An invalid medium or model parameter (exit code 2).
     Bssrdf(BssrdfError),
-    /// A plot could not be drawn or written (exit code 1).
-    Plot(PlotError),
     /// An I/O failure, with what was being done (exit code 1).
     Io {
         /// What was being read or written.
@@ -36,10 +33,9 @@ impl Error {
     pub fn exit_code(&self) -> u8 {
         match self {
             Error::Input(_) | Error::Bssrdf(_) => 2,
-            Error::Plot(PlotError::UnsupportedFormat(_)) => 2,
             Error::Scene(e) if e.kind == SceneErrorKind::Io => 1,
             Error::Scene(_) => 2,
-            Error::Plot(_) | Error::Io { .. } | Error::NonFinite(_) => 1,
+            Error::Io { .. } | Error::NonFinite(_) => 1,
         }
     }
 }
@@ -49,7 +45,6 @@ impl fmt::Display for Error {
         match self {
             Error::Input(msg) | Error::NonFinite(msg) => f.write_str(msg),
             Error::Bssrdf(e) => write!(f, "{e}"),
-            Error::Plot(e) => write!(f, "{e}"),
             Error::Scene(e) => write!(f, "{e}"),
             Error::Io { what, source } => write!(f, "{what}: {source}"),
         }
@@ -60,7 +55,6 @@ impl std::error::Error for Error {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             Error::Bssrdf(e) => Some(e),
-            Error::Plot(e) => Some(e),
             Error::Scene(e) => Some(e),
             Error::Io { source, .. } => Some(source),
             _ => None,
@@ -71,12 +65,6 @@ impl std::error::Error for Error {
 impl From<BssrdfError> for Error {
     fn from(e: BssrdfError) -> Self {
         Error::Bssrdf(e)
-    }
-}
-
-impl From<PlotError> for Error {
-    fn from(e: PlotError) -> Self {
-        Error::Plot(e)
     }
 }
 

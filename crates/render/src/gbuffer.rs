@@ -4,9 +4,9 @@
 
 use crate::camera::{CameraFrame, pixel_samples};
 use crate::geometry::SceneGeometry;
-use sss_scene::Scene;
 use glam::DVec3;
 use rayon::prelude::*;
+use sss_scene::Scene;
 
 /// One pixel sample that hit a surface.
 #[derive(Clone, Copy, Debug, PartialEq)]

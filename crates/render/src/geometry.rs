@@ -2,9 +2,9 @@
 //! rays of the BSSRDF sampler can be limited to their own object and the scene is only a short
 //! list of per-object BVHs with bounding boxes.
 
-use sss_scene::{Mesh, Scene};
 use glam::DVec3;
 use sss_hierarchy::TriangleBvh;
+use sss_scene::{Mesh, Scene};
 
 /// Where a ray met a surface.
 #[derive(Clone, Copy, Debug, PartialEq)]

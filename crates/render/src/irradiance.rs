@@ -11,11 +11,11 @@
 use crate::geometry::{SceneGeometry, triangles_of};
 use crate::lights::{Incident, Receiver, gather};
 use crate::rng::{Stream, rng};
-use sss_scene::Scene;
+use crate::shading::transmitted_irradiance;
 use glam::DVec3;
 use rayon::prelude::*;
-use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{ModelKind, Rgb};
+use sss_scene::Scene;
 
 /// How densely to sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,8 +98,9 @@ pub fn compute(
             let spacing = settings.spacing_mfp * mfp_mm * mat.units_per_mm;
             let mesh = geom.mesh(o);
             let tris = triangles_of(mesh);
-            let place_seed =
-                crate::rng::mix64(seed ^ crate::rng::mix64(Stream::Placement as u64 + o as u64));
+            let place_seed = sss_util::splitmix64(
+                seed ^ sss_util::splitmix64(Stream::Placement as u64 + o as u64),
+            );
             let (points, stats) =
                 sss_hierarchy::blue_noise_on_mesh(&tris, spacing, settings.max_samples, place_seed);
             let directional = mat.model == ModelKind::DirectionalDipole;
@@ -138,14 +139,7 @@ pub fn compute(
                         .texture
                         .as_ref()
                         .map_or([1.0; 3], |t| t.eval(s.position));
-                    let mut e = [0.0; 3];
-                    for packet in &mut inc {
-                        let ft = ft_dielectric(n.dot(packet.dir), eta);
-                        for ch in 0..3 {
-                            packet.e_cos[ch] *= tex[ch];
-                            e[ch] += ft * packet.e_cos[ch];
-                        }
-                    }
+                    let e = transmitted_irradiance(&mut inc, n, eta, tex);
                     let sample = IrradianceSample {
                         position: s.position,
                         normal: n,

@@ -1,29 +1,62 @@
-//! # sss-render: the subsurface-scattering toolkit's front end
+//! # sss-render: render the subsurface term of a scene with any integrator
 //!
-//! Today this crate holds the `sss` command-line tool and the pieces around it that other
-//! tools reuse: PNG/SVG line plots ([`plot`]), radial-profile tables of any model or of the
-//! Monte Carlo reference ([`profile`]), the measured-material table ([`presets_table`]) and
-//! progress bars ([`progress`]). Scenes, ray casting and the subsurface integrators will live
-//! here later.
+//! A thin library composing the toolkit's crates behind one integrator interface: ray casting
+//! (one exact BVH per object, `sss-hierarchy`), the G-buffer, direct lighting with shadow rays,
+//! irradiance samples, the [`integrators`] (`exact`, `pathtrace`, `separable`, each one file
+//! under `integrators/`), image output (EXR, PNG) and image [`metrics`]. Use it to render a
+//! scene from code or to add a method; the `sss` binary (crate `sss-cli`) and `cargo xtask
+//! compare` are thin layers over it. It pulls in no CLI, progress-bar or plotting crate:
+//! progress reaches the caller through [`progress::Progress`].
 //!
 //! ```
-//! use sss_render::profile::{compute, MediumSpec, ProfileModel, ProfileRequest};
+//! use sss_render::integrators::{self, MethodOptions};
+//! use sss_render::progress::NoProgress;
+//! use sss_render::render::{RenderSettings, render};
+//! use sss_render::scene::{LoadOptions, load_str};
 //!
-//! // Rd(r) of the directional dipole for skim milk at 8 radii up to 10 mm.
-//! let req = ProfileRequest {
-//!     steps: 8,
-//!     ..ProfileRequest::new(ProfileModel::DirectionalDipole, MediumSpec::Preset("skimmilk".into()), 10.0)
-//! };
-//! let table = compute(&req, &|_| {})?;
-//! assert_eq!(table.rows.len(), 8);
-//! assert!(table.rows.iter().all(|row| row.rd.iter().all(|v| v.is_finite() && *v >= 0.0)));
+//! let text = r#"
+//! [camera]
+//! position = [0.0, 0.0, 4.0]
+//! target = [0.0, 0.0, 0.0]
+//! up = [0.0, 1.0, 0.0]
+//! fov = 30.0
+//! resolution = [16, 12]
+//!
+//! [[lights]]
+//! type = "directional"
+//! direction = [0.0, 0.0, -1.0]
+//! irradiance = 1.0
+//!
+//! [materials.skin]
+//! type = "translucent"
+//! model = "better-dipole"
+//! preset = "skin1"
+//! units_per_mm = 0.1
+//!
+//! [[objects]]
+//! material = "skin"
+//! shape = "sphere"
+//! radius = 1.0
+//! "#;
+//! let scene = load_str(text, "doc.toml", None, &LoadOptions::default())?;
+//! let method = integrators::build("pathtrace", &MethodOptions::new().with("spp", 4))?;
+//! let out = render(&scene, method.as_ref(), &RenderSettings::default(), &NoProgress)?;
+//! assert_eq!(out.subsurface.len(), 16 * 12);
+//! assert!(out.subsurface.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+//! assert!(out.translucent_pixels().len() > 0);
 //! # Ok::<(), sss_render::Error>(())
 //! ```
 //!
 //! ## Papers
-//! None of its own yet: it composes the models of `sss-bssrdf` (Jensen et al. 2001, d'Eon
-//! 2012, Frisvad et al. 2014, Habel et al. 2013) and its Monte Carlo reference (MCML, Wang et
-//! al. 1995).
+//! - Jensen & Buhler 2002, *A rapid hierarchical rendering technique for translucent
+//!   materials*: irradiance samples and the point-based sum ([`irradiance`], `exact`).
+//! - Pharr, Jakob & Humphreys, *Physically Based Rendering* 3rd ed., §11.4 and §15.4: the
+//!   separable BSSRDF S_ω normalisation and BSSRDF importance sampling with probe rays
+//!   (`pathtrace`).
+//! - Jimenez et al. 2015, *Separable Subsurface Scattering*: the screen-space pass
+//!   (`separable`, kernels from `sss-separable`).
+//! - The models of `sss-bssrdf` (Jensen et al. 2001, d'Eon 2012, Frisvad et al. 2014, Habel et
+//!   al. 2013).
 
 // `!(x > 0.0)` is the NaN-rejecting comparison used throughout the numerical code.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -31,23 +64,20 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod camera;
-pub mod cli;
 mod error;
-pub mod filter_cli;
+pub mod frame;
 pub mod gbuffer;
 pub mod geometry;
 pub mod image;
 pub mod integrators;
 pub mod irradiance;
-pub mod kernel_cli;
+pub mod kernel_choice;
 pub mod lights;
-pub mod plot;
-pub mod presets_table;
-pub mod profile;
+pub mod metrics;
 pub mod progress;
 pub mod render;
-pub mod render_cli;
 pub mod rng;
+pub mod shading;
 
 pub use error::Error;
 /// The scene format (re-exported from `sss-scene`).

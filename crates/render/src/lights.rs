@@ -3,11 +3,11 @@
 //! opaque ones.
 
 use crate::geometry::SceneGeometry;
-use sss_scene::Light;
 use glam::DVec3;
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 use sss_bssrdf::Rgb;
+use sss_scene::Light;
 use std::f64::consts::PI;
 
 /// One packet of light reaching a point: the unit direction it comes from and its

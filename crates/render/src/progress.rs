@@ -1,16 +1,21 @@
-//! Progress bars on stderr, shared by the `sss` binary and the `xtask` harness.
+//! Progress reporting without a progress-bar dependency: the renderer calls a [`Progress`]
+//! the caller provides (the `sss` binary hands it an indicatif bar; libraries and tests pass
+//! [`NoProgress`]).
 
-use indicatif::{ProgressBar, ProgressStyle};
-
-/// A progress bar of `len` steps counting `unit`s on stderr. It is hidden automatically when
-/// stderr is not a terminal (CI logs stay clean).
-pub fn bar(len: u64, unit: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len);
-    let template = format!(
-        "{{spinner}} [{{elapsed_precise}}] {{wide_bar}} {{human_pos}}/{{human_len}} {unit} ({{eta}}) {{msg}}"
-    );
-    if let Ok(style) = ProgressStyle::with_template(&template) {
-        bar.set_style(style);
+/// Receives a render's progress. Called from worker threads, so implementations are `Sync`.
+pub trait Progress: Sync {
+    /// Work is about to start: `total` units (pixel samples) in all.
+    fn start(&self, total: u64) {
+        let _ = total;
     }
-    bar
+    /// `n` more units are done.
+    fn advance(&self, n: u64) {
+        let _ = n;
+    }
 }
+
+/// Ignores progress.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoProgress;
+
+impl Progress for NoProgress {}

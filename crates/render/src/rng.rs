@@ -4,14 +4,6 @@
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 
-/// SplitMix64 finaliser (Steele et al. 2014): a bijective 64-bit mix.
-pub fn mix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
 /// Distinct streams of one render, so that (say) pixel 7 of the camera and irradiance sample 7
 /// never share random numbers.
 #[derive(Clone, Copy, Debug)]
@@ -31,6 +23,7 @@ pub enum Stream {
 
 /// The generator for work item `index` of `stream` under `seed`.
 pub fn rng(seed: u64, stream: Stream, index: u64) -> Pcg64Mcg {
+    use sss_util::splitmix64 as mix64;
     let s = mix64(mix64(seed ^ mix64(stream as u64)) ^ index);
     Pcg64Mcg::seed_from_u64(s)
 }

@@ -7,8 +7,12 @@ use glam::DVec3;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{Medium, ModelKind, fresnel_normalization, make_model};
 use sss_render::geometry::SceneGeometry;
+use sss_render::integrators::Integrator;
+use sss_render::integrators::exact::Exact;
+use sss_render::integrators::pathtrace::PathTrace;
 use sss_render::irradiance::{self, IrradianceSettings};
-use sss_render::render::{Method, RenderOutput, RenderSettings, render};
+use sss_render::progress::NoProgress;
+use sss_render::render::{RenderOutput, RenderSettings, render};
 use sss_render::scene::{Camera, Light, Material, MaterialKind, Mesh, Object, Scene, Translucent};
 use std::f64::consts::PI;
 
@@ -133,16 +137,14 @@ fn flat_slab_matches_closed_form() {
         }],
         camera,
     );
-    let settings = RenderSettings {
-        method: Method::Exact,
+    let exact = Exact {
         irradiance: IrradianceSettings {
             spacing_mfp: 0.25,
             max_samples: 1_000_000,
             light_samples: 1,
         },
-        ..RenderSettings::default()
     };
-    let out = render(&scene, &settings, None).unwrap();
+    let out = render(&scene, &exact, &RenderSettings::default(), &NoProgress).unwrap();
     let medium = Medium::preset("marble").unwrap();
     let model = make_model(ModelKind::BetterDipole, &medium);
     let eta = medium.eta();
@@ -197,27 +199,25 @@ fn pathtrace_agrees_with_exact_on_a_sphere() {
     let scene = sphere_scene(ModelKind::BetterDipole);
     let exact = render(
         &scene,
-        &RenderSettings {
-            method: Method::Exact,
+        &Exact {
             irradiance: IrradianceSettings {
                 spacing_mfp: 0.25,
                 max_samples: 400_000,
                 light_samples: 1,
             },
-            ..RenderSettings::default()
         },
-        None,
+        &RenderSettings::default(),
+        &NoProgress,
     )
     .unwrap();
     let pt = render(
         &scene,
+        &PathTrace { spp: 256 },
         &RenderSettings {
-            method: Method::PathTrace,
-            spp: 256,
             seed: 7,
             ..RenderSettings::default()
         },
-        None,
+        &NoProgress,
     )
     .unwrap();
     let px = pixels(&exact);
@@ -260,10 +260,9 @@ fn pathtrace_agrees_with_exact_on_a_sphere() {
 #[test]
 fn renders_are_deterministic() {
     let scene = sphere_scene(ModelKind::StandardDipole);
-    for method in [Method::Exact, Method::PathTrace] {
+    let methods: [&dyn Integrator; 2] = [&Exact::default(), &PathTrace { spp: 2 }];
+    for method in methods {
         let s = RenderSettings {
-            method,
-            spp: 2,
             seed: 3,
             ..RenderSettings::default()
         };
@@ -272,25 +271,26 @@ fn renders_are_deterministic() {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| render(&scene, &s, None).unwrap())
+                .install(|| render(&scene, method, &s, &NoProgress).unwrap())
         };
         let (a, b) = (run(1), run(2));
-        assert_eq!(a.subsurface, b.subsurface, "{method:?}");
-        assert_eq!(a.total, b.total, "{method:?}");
+        assert_eq!(a.subsurface, b.subsurface, "{}", method.name());
+        assert_eq!(a.total, b.total, "{}", method.name());
         assert!(
             a.subsurface
                 .iter()
                 .flatten()
                 .all(|v| v.is_finite() && *v >= 0.0)
         );
-        if method == Method::PathTrace {
+        if method.name() == "pathtrace" {
             let other = render(
                 &scene,
+                method,
                 &RenderSettings {
                     seed: 4,
                     ..s.clone()
                 },
-                None,
+                &NoProgress,
             )
             .unwrap();
             assert_ne!(a.subsurface, other.subsurface);

@@ -36,6 +36,7 @@
 use crate::error::{SeparableError, ensure};
 use crate::kernel::{Kernel1d, SeparableKernel};
 use rayon::prelude::*;
+use sss_util::splitmix64;
 
 /// The `mask` value of pixels that show no translucent object.
 pub const NO_OBJECT: u32 = u32::MAX;
@@ -146,12 +147,7 @@ pub const ROTATION_STEPS: usize = 256;
 /// SplitMix64 hash of the pixel coordinates and `seed`, reduced to a rotation index.
 #[inline(always)]
 fn rotation_index(x: usize, y: usize, seed: u64) -> usize {
-    let mut z = seed
-        .wrapping_add(((y as u64) << 32) ^ (x as u64))
-        .wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
+    let z = splitmix64(seed.wrapping_add(((y as u64) << 32) ^ (x as u64)));
     (z >> 56) as usize % ROTATION_STEPS
 }
 

@@ -165,7 +165,12 @@ mod tests {
         let t = temp_path(Path::new("out/dir/img.png"));
         assert_eq!(t.parent(), Some(Path::new("out/dir")));
         assert_eq!(t.extension().and_then(|e| e.to_str()), Some("png"));
-        assert!(t.file_name().unwrap().to_string_lossy().starts_with(".img.png."));
+        assert!(
+            t.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with(".img.png.")
+        );
         let bare = temp_path(Path::new("x.csv"));
         assert!(bare.parent().is_none_or(|p| p.as_os_str().is_empty()));
     }

@@ -14,11 +14,10 @@
 use super::output::{csv_num, md_num, md_table, write_atomic};
 use super::{Context, Error, Experiment, Section};
 use sss_bssrdf::{Medium, ModelKind, Rgb, make_model};
-use sss_render::image::{auto_exposure, write_error_map, write_png};
-use sss_render::integrators::separable::{
-    KernelMethod, MaterialKernel, SeparableSettings, build_kernel,
-};
-use sss_render::plot::{PALETTE, Series, SeriesStyle, line_plot};
+use sss_plot::write_error_map;
+use sss_plot::{PALETTE, Series, SeriesStyle, line_plot};
+use sss_render::image::{auto_exposure, write_png};
+use sss_render::kernel_choice::{KernelMethod, MaterialKernel, SeparableSettings, build_kernel};
 use sss_separable::{
     FilterOptions, Kernel2d, Kernel2dSpec, NO_OBJECT, ScreenInput, SeparableKernel, TapPlacement,
     artist, convolve2d, screen_space, svd,
@@ -147,9 +146,11 @@ fn timed_filter(frame: &Frame, kernel: &SeparableKernel, threads: usize) -> Resu
 
 /// Every kernel on the `sphere` and `slab` scenes against their cached `exact` references.
 fn world_space(ctx: &Context<'_>) -> Result<Vec<Vec<String>>, Error> {
-    use super::scenes::{load_scenes, reference, reference_settings};
-    use sss_render::render::{Method, render};
-    use sss_render::render_cli::error_figures;
+    use super::scenes::{load_scenes, reference};
+    use sss_render::integrators::separable::Separable;
+    use sss_render::metrics::error_figures;
+    use sss_render::progress::NoProgress;
+    use sss_render::render::{RenderSettings, render};
     // Only the two scenes whose materials the table is about, if the run includes them.
     let names: Vec<String> = ctx
         .config
@@ -174,16 +175,19 @@ fn world_space(ctx: &Context<'_>) -> Result<Vec<Vec<String>>, Error> {
                 _ => &[true, false],
             };
             for &importance in placements {
-                let settings = sss_render::render::RenderSettings {
-                    method: Method::Separable,
-                    separable: SeparableSettings {
+                let separable = Separable {
+                    kernel: SeparableSettings {
                         kernel: method,
                         importance,
                         ..SeparableSettings::default()
                     },
-                    ..reference_settings(ctx.config.seed, ctx.config.quick)
+                    ..Separable::default()
                 };
-                let out = render(scene, &settings, None)
+                let settings = RenderSettings {
+                    seed: ctx.config.seed,
+                    ..RenderSettings::default()
+                };
+                let out = render(scene, &separable, &settings, &NoProgress)
                     .map_err(|e| Error(format!("{}: {method}: {e}", scene.name)))?;
                 let f = error_figures(&out.subsurface, &r.subsurface, &pixels, 0.05);
                 let sum = |img: &[Rgb]| -> f64 {
@@ -352,7 +356,7 @@ impl Experiment for KernelComparison {
                             &format!("{name}: pre-integrated (7 taps) vs exact 2D, red"),
                             "|a-b|/b",
                         )
-                        .map_err(e)?;
+                        .map_err(|e| Error(e.to_string()))?;
                     }
                     rows.push(Row {
                         material: name.into(),

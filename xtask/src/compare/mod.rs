@@ -145,7 +145,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
             config.out.display()
         ))
     })?;
-    let bar = sss_render::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
+    let bar = sss_cli::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
     let log = |msg: &str| {
         if bar.is_hidden() {
             eprintln!("{msg}");

@@ -17,7 +17,7 @@ use super::reference::{CHANNEL_NAMES, McPart, PresetReference};
 use super::{Context, Error, Experiment, Section};
 use sss_bssrdf::photon_beam_diffusion::PbdTable;
 use sss_bssrdf::{Bssrdf, Medium, ModelKind, make_model};
-use sss_render::plot::{ErrorStyle, PALETTE, Panel, Series, SeriesStyle, panel_plot};
+use sss_plot::{ErrorStyle, PALETTE, Panel, Series, SeriesStyle, panel_plot};
 use std::fmt::Write as _;
 use std::hint::black_box;
 use std::time::Instant;
@@ -325,7 +325,7 @@ fn plot_error_vs_cost(
                 .with_style(SeriesStyle::Markers)
         })
         .collect();
-    sss_render::plot::line_plot(
+    sss_plot::line_plot(
         &ctx.config.out.join("error_vs_cost.png"),
         "Relative L2 error against cost (one point per preset and channel)",
         "ns per Rd evaluation",
@@ -479,7 +479,7 @@ impl Experiment for ProfileComparison {
     fn run(&self, ctx: &Context<'_>) -> Result<Section, Error> {
         let methods = methods();
         let method_names: Vec<String> = methods.iter().map(|m| m.name()).collect();
-        let bar = sss_render::progress::bar(ctx.references.len() as u64, "presets");
+        let bar = sss_cli::progress::bar(ctx.references.len() as u64, "presets");
         bar.set_message("profiles");
         let mut evals = Vec::new();
         let mut body = String::new();

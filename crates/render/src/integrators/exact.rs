@@ -1,19 +1,151 @@
 //! The `exact` reference: at each shading point, the sum over every irradiance sample of its
 //! object of the model's contribution, with no hierarchy and no culling. Ground truth for the
-//! hierarchical methods (single tree, dual tree, many-light) on the same points.
+//! hierarchical methods (single tree, dual tree, many-light) on the same points: their error
+//! against it is the hierarchy's error alone.
 
-use super::{TranslucentShading, add_scaled};
+use super::add_scaled;
+use super::{Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep};
+use crate::Error;
+use crate::frame::Frame;
 use crate::gbuffer::GSample;
-use crate::irradiance::ObjectSamples;
-use sss_bssrdf::fresnel::ft_dielectric;
+use crate::irradiance::{IrradianceSettings, ObjectSamples};
+use crate::progress::Progress;
+use crate::shading::TranslucentShading;
+use rayon::prelude::*;
 use sss_bssrdf::{Rgb, SurfacePoint};
+
+/// The irradiance-sample options shared by every point-based method.
+pub const SAMPLE_OPTIONS: [OptionSpec; 2] = [
+    OptionSpec {
+        name: "spacing",
+        value_name: "MFP",
+        default: "0.5",
+        help: "Irradiance sample spacing in units of the smallest reduced mean free path",
+        kind: OptionKind::Value,
+    },
+    OptionSpec {
+        name: "max-samples",
+        value_name: "N",
+        default: "100000",
+        help: "At most this many irradiance samples per object (the spacing grows to respect it)",
+        kind: OptionKind::Value,
+    },
+];
+
+/// Reads and checks the irradiance-sample options.
+pub fn sample_settings(o: &MethodOptions) -> Result<IrradianceSettings, Error> {
+    let spacing: f64 = o.get(&SAMPLE_OPTIONS, "spacing")?;
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Err(Error::Input(format!(
+            "--spacing must be positive, got {spacing}"
+        )));
+    }
+    Ok(IrradianceSettings {
+        spacing_mfp: spacing,
+        max_samples: o.get(&SAMPLE_OPTIONS, "max-samples")?,
+        ..IrradianceSettings::default()
+    })
+}
+
+/// The irradiance-sample spacing (mean free paths) of `cargo xtask compare`'s reference: the
+/// default, or twice it with `--quick`.
+pub fn reference_spacing(quick: bool) -> f64 {
+    let default = IrradianceSettings::default().spacing_mfp;
+    if quick { 2.0 * default } else { default }
+}
+
+/// The registry entry.
+pub const METHOD: Method = Method {
+    name: "exact",
+    about: "Brute-force sum over all irradiance samples",
+    options: &SAMPLE_OPTIONS,
+    build: |o| Ok(Box::new(Exact::from_options(o)?)),
+    sweep: Sweep {
+        option: "spacing",
+        label: "spacing_mfp",
+        // Coarser samples than the reference (×8, ×4, ×2; ×4, ×2 with --quick): how the error
+        // grows as the samples thin out.
+        values: |quick| {
+            let factors: &[f64] = if quick { &[4.0, 2.0] } else { &[8.0, 4.0, 2.0] };
+            factors
+                .iter()
+                .map(|f| f * reference_spacing(quick))
+                .collect()
+        },
+    },
+};
+
+/// The `exact` integrator and its settings.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Exact {
+    /// Irradiance sample placement and lighting.
+    pub irradiance: IrradianceSettings,
+}
+
+impl Exact {
+    /// The settings `options` describe.
+    pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
+        Ok(Exact {
+            irradiance: sample_settings(o)?,
+        })
+    }
+}
+
+impl Integrator for Exact {
+    fn name(&self) -> &'static str {
+        METHOD.name
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "irradiance sample spacing {} mean free paths, at most {} per object",
+            self.irradiance.spacing_mfp, self.irradiance.max_samples
+        )
+    }
+
+    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        let samples = frame.irradiance_samples(&self.irradiance);
+        let by_object = frame.samples_by_object(&samples);
+        let values: Vec<Rgb> = frame.timed("shading", || {
+            frame
+                .gbuffer
+                .samples
+                .par_iter()
+                .map(|g| {
+                    let v = match (frame.shading_of(g.object), by_object[g.object as usize]) {
+                        (Some(sh), Some(s)) => shade(g, sh, s),
+                        _ => [0.0; 3],
+                    };
+                    progress.advance(1);
+                    v
+                })
+                .collect()
+        });
+        let evaluations: usize = frame
+            .gbuffer
+            .samples
+            .iter()
+            .filter(|g| frame.shading_of(g.object).is_some())
+            .map(|g| by_object[g.object as usize].map_or(0, |s| s.samples.len()))
+            .sum();
+        Ok(Shaded {
+            values,
+            stats: vec![Stat {
+                name: "sample_pairs",
+                value: evaluations as f64,
+            }],
+            ..Shaded::default()
+        })
+    }
+}
 
 /// The subsurface radiance leaving `g` towards the camera.
 pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples) -> Rgb {
     let mut sum = [0.0; 3];
-    if shading.directional {
+    if shading.directional() {
         // Full S of the directional dipole, positions in mm.
         let u = shading.units_per_mm;
+        let model = shading.bssrdf();
         let xo = SurfacePoint { p: g.p / u, n: g.n };
         for (i, s) in samples.samples.iter().enumerate() {
             let xi = SurfacePoint {
@@ -22,7 +154,7 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
             };
             let a = s.area / (u * u);
             for packet in samples.incident_of(i) {
-                let sv = shading.model.s(&xi, packet.dir, &xo, g.wo);
+                let sv = model.s(&xi, packet.dir, &xo, g.wo);
                 for c in 0..3 {
                     sum[c] += sv[c] * packet.e_cos[c] * a;
                 }
@@ -37,10 +169,6 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
         }
     }
     let mut out = [0.0; 3];
-    add_scaled(
-        &mut out,
-        sum,
-        ft_dielectric(g.n.dot(g.wo), shading.eta) * shading.norm,
-    );
+    add_scaled(&mut out, sum, shading.exit_weight(g.n, g.wo));
     out
 }

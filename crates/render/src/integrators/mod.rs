@@ -1,73 +1,131 @@
-//! Integrators: ways to compute the subsurface term at the G-buffer's points. Each computes
-//! the same quantity (see `ARCHITECTURE.md`):
+//! Integrators: ways to compute the subsurface term at the G-buffer's points, behind one
+//! interface ([`Integrator`]) and listed in one registry ([`METHODS`]).
 //!
-//! L(x_o, ω_o) = F_t(η, cos θ_o)/(cπ) Σ_i R_d(‖x_i − x_o‖) E_i A_i for separable models
-//! (pbrt 3rd ed. Eq. 11.6-11.7 with c = 1 − 2C₁(η)), and Σ_i A_i Σ_k S(x_i, ω_k; x_o, ω_o) E_k
-//! for the directional dipole, or the integral these sums approximate.
+//! Each computes the same quantity (see [`crate::shading`] and `ARCHITECTURE.md`):
+//! L(x_o, ω_o) = F_t(η, cos θ_o)/(cπ) Σ_i R_d(‖x_i − x_o‖) E_i A_i for radial models, the full S
+//! of the directional dipole summed over incident packets otherwise, or the integral these sums
+//! approximate.
+//!
+//! # The contract
+//! An integrator works on a whole [`Frame`] (the tree, many-light and separable methods shade
+//! sets of pixels together). It receives the prepared frame — G-buffer, per-object BVHs, lights,
+//! per-material [`TranslucentShading`](crate::shading::TranslucentShading), and irradiance
+//! samples built on request ([`Frame::irradiance_samples`]) — and returns a [`Shaded`]: one
+//! subsurface value per G-buffer sample (0 for samples not on a visible translucent object;
+//! finite and non-negative), an optional per-pixel standard error, its own statistics and any
+//! extra per-pixel layers. It times its stages with [`Frame::timed`] and reports progress in
+//! G-buffer samples. Same frame seed, same output, for any thread count.
+//!
+//! # Adding a method
+//! One new file here with the settings type (implementing [`Integrator`]) and a [`Method`]
+//! entry (name, options, constructor, compare sweep), and one line in [`METHODS`]. The `sss
+//! render` flags, the `cargo xtask compare` sweep and the pipeline all read the registry.
 
 pub mod exact;
+pub mod options;
 pub mod pathtrace;
 pub mod separable;
 
-use sss_scene::{Scene, Texture, Translucent};
-use sss_bssrdf::{Bssrdf, ModelKind, Rgb, fresnel_normalization, make_model};
-use std::f64::consts::PI;
+pub use options::{MethodOptions, OptionKind, OptionSpec};
 
-/// What an integrator needs of one translucent material, in scene units.
-pub struct TranslucentShading {
-    /// The model (built once per material).
-    pub model: Box<dyn Bssrdf>,
-    /// Scene units per millimetre.
-    pub units_per_mm: f64,
-    /// Relative index of refraction.
-    pub eta: f64,
-    /// 1/(cπ), the separable directional normalisation.
-    pub norm: f64,
-    /// True when the model needs incident directions (the directional dipole).
-    pub directional: bool,
-    /// The pre-scatter texture.
-    pub texture: Option<Texture>,
+use crate::Error;
+use crate::frame::Frame;
+use crate::progress::Progress;
+use sss_bssrdf::Rgb;
+
+/// One method's output on a frame.
+#[derive(Clone, Debug, Default)]
+pub struct Shaded {
+    /// The subsurface value of every G-buffer sample, indexed like `frame.gbuffer.samples`
+    /// (0 for samples not on a visible translucent object).
+    pub values: Vec<Rgb>,
+    /// Per pixel: the standard error of the pixel's subsurface estimate (stochastic methods).
+    pub std_error: Option<Vec<Rgb>>,
+    /// The method's own counts (nodes visited, BSSRDF evaluations, paths, taps, ...).
+    pub stats: Vec<Stat>,
+    /// Extra per-pixel images the method produces (e.g. the separable pass's screen-space
+    /// inputs), row-major like the output images.
+    pub layers: Vec<Layer>,
 }
 
-impl TranslucentShading {
-    /// Builds the model of a translucent material.
-    pub fn new(t: &Translucent) -> Self {
-        let model = make_model(t.model, &t.medium);
-        let eta = t.medium.eta();
-        TranslucentShading {
-            model,
-            units_per_mm: t.units_per_mm,
-            eta,
-            norm: 1.0 / (fresnel_normalization(eta) * PI),
-            directional: t.model == ModelKind::DirectionalDipole,
-            texture: t.texture.clone(),
-        }
-    }
-
-    /// R_d at scene-unit distance `r`, per scene unit² (R_d(r/u)/u², u = units per mm).
-    #[inline]
-    pub fn rd_scene(&self, r: f64) -> Rgb {
-        let u = self.units_per_mm;
-        let rd = self.model.rd_rgb(r / u);
-        let s = 1.0 / (u * u);
-        [rd[0] * s, rd[1] * s, rd[2] * s]
-    }
+/// A named count or measure of a method's work.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stat {
+    /// Name (snake_case).
+    pub name: &'static str,
+    /// Value.
+    pub value: f64,
 }
 
-/// The shading data of every material that some translucent object in `objects` uses (None
-/// for the others): models and tables are built only for what the image shows.
-pub fn shading_for(scene: &Scene, objects: &[u32]) -> Vec<Option<TranslucentShading>> {
-    let mut out: Vec<Option<TranslucentShading>> =
-        (0..scene.materials.len()).map(|_| None).collect();
-    for &o in objects {
-        let m = scene.objects[o as usize].material;
-        if out[m].is_none()
-            && let Some(t) = scene.translucent(o as usize)
-        {
-            out[m] = Some(TranslucentShading::new(t));
-        }
+/// A named per-pixel RGB image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layer {
+    /// Layer name (as written to EXR).
+    pub name: &'static str,
+    /// Pixels, row-major from the top-left.
+    pub pixels: Vec<Rgb>,
+}
+
+/// A way to compute the subsurface term of a whole frame.
+pub trait Integrator: Send + Sync {
+    /// The registry name (`exact`, `pathtrace`, ...).
+    fn name(&self) -> &'static str;
+    /// One line describing the settings, for summaries.
+    fn describe(&self) -> String;
+    /// Names of the extra layers [`Shaded::layers`] will hold (empty for most methods).
+    fn layer_names(&self) -> &'static [&'static str] {
+        &[]
     }
-    out
+    /// Shades every G-buffer sample on a visible translucent object of `frame`.
+    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error>;
+}
+
+/// How `cargo xtask compare` sweeps a method: one option over values, cheapest first.
+#[derive(Clone, Copy, Debug)]
+pub struct Sweep {
+    /// The option swept (a name from [`Method::options`]).
+    pub option: &'static str,
+    /// The parameter's name in reports (`results.csv`'s `param` column).
+    pub label: &'static str,
+    /// Values, cheapest first; the argument is `--quick`.
+    pub values: fn(bool) -> Vec<f64>,
+}
+
+/// A registry entry: everything the CLI, `compare` and the pipeline need to know of a method.
+#[derive(Clone, Copy, Debug)]
+pub struct Method {
+    /// Name on the command line and in reports.
+    pub name: &'static str,
+    /// One line for `--help`.
+    pub about: &'static str,
+    /// Its options (`sss render --<name> <value>`), with defaults.
+    pub options: &'static [OptionSpec],
+    /// Builds the integrator from option values (defaults for the ones not given); errors
+    /// name the offending flag.
+    pub build: fn(&MethodOptions) -> Result<Box<dyn Integrator>, Error>,
+    /// Its sweep in `cargo xtask compare`.
+    pub sweep: Sweep,
+}
+
+/// Every rendering method, in report order.
+pub const METHODS: &[Method] = &[exact::METHOD, pathtrace::METHOD, separable::METHOD];
+
+/// The registry entry named `name`.
+pub fn method(name: &str) -> Result<&'static Method, Error> {
+    METHODS.iter().find(|m| m.name == name).ok_or_else(|| {
+        let names: Vec<&str> = METHODS.iter().map(|m| m.name).collect();
+        Error::Input(format!(
+            "unknown method `{name}` (known: {})",
+            names.join(", ")
+        ))
+    })
+}
+
+/// Builds the method `name` with `options` (the other options at their defaults).
+pub fn build(name: &str, options: &MethodOptions) -> Result<Box<dyn Integrator>, Error> {
+    let m = method(name)?;
+    options.check_known(m)?;
+    (m.build)(options)
 }
 
 /// Adds `s·v` to `acc`.

@@ -17,16 +17,21 @@
 //! irradiance samples, so it is the ground truth for the whole pipeline, sample density
 //! included.
 
-use super::TranslucentShading;
+use super::{Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep};
+use crate::Error;
+use crate::frame::Frame;
 use crate::gbuffer::GSample;
 use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::lights::{Incident, Receiver, gather, tangent_frame};
-use sss_scene::Light;
+use crate::progress::Progress;
+use crate::rng::{Stream, rng};
+use crate::shading::{TranslucentShading, transmitted_irradiance};
 use glam::DVec3;
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
-use sss_bssrdf::fresnel::ft_dielectric;
+use rayon::prelude::*;
 use sss_bssrdf::{Rgb, SurfacePoint};
+use sss_scene::Light;
 use std::f64::consts::PI;
 
 /// Energy fraction of each channel's profile inside the probe sphere.
@@ -46,7 +51,7 @@ impl ProbeRadii {
     pub fn new(shading: &TranslucentShading) -> Self {
         let mut rmax = [0.0; 3];
         for (c, r) in rmax.iter_mut().enumerate() {
-            let v = shading.model.radius_for_energy(c, RMAX_FRACTION) * shading.units_per_mm;
+            let v = shading.bssrdf().radius_for_energy(c, RMAX_FRACTION) * shading.units_per_mm;
             *r = if v.is_finite() && v > 0.0 { v } else { 0.0 };
         }
         ProbeRadii { rmax }
@@ -58,7 +63,7 @@ impl ProbeRadii {
 fn plane_pdf(shading: &TranslucentShading, ch: usize, r: f64, rmax: f64) -> f64 {
     let u = shading.units_per_mm;
     let r_mm = (r / u).max(rmax / u * 1e-9).max(1e-300);
-    let p = shading.model.pdf_sr(ch, r_mm) / (2.0 * PI * r_mm) / (u * u);
+    let p = shading.bssrdf().pdf_sr(ch, r_mm) / (2.0 * PI * r_mm) / (u * u);
     if p.is_finite() && p > 0.0 { p } else { 0.0 }
 }
 
@@ -202,7 +207,7 @@ impl Sampler<'_> {
             return [0.0; 3];
         }
         let u = shading.units_per_mm;
-        let r = shading.model.sample_sr(ch, rng.random::<f64>()) * u;
+        let r = shading.bssrdf().sample_sr(ch, rng.random::<f64>()) * u;
         if !(r.is_finite() && r >= 0.0) || r > rmax {
             return [0.0; 3];
         }
@@ -242,31 +247,26 @@ impl Sampler<'_> {
         if packets.is_empty() {
             return [0.0; 3];
         }
-        let tex = shading.texture.as_ref().map_or([1.0; 3], |t| t.eval(pi.p));
+        let tex = shading.texture_at(pi.p);
         let mut out = [0.0; 3];
-        if shading.directional {
+        if shading.directional() {
             let xo = SurfacePoint { p: g.p / u, n: g.n };
             let xi = SurfacePoint {
                 p: pi.p / u,
                 n: pi.n,
             };
             let s_area = 1.0 / (u * u * pdf);
+            let model = shading.bssrdf();
             for packet in packets.iter() {
-                let sv = shading.model.s(&xi, packet.dir, &xo, g.wo);
+                let sv = model.s(&xi, packet.dir, &xo, g.wo);
                 for c in 0..3 {
                     out[c] += sv[c] * packet.e_cos[c] * tex[c] * s_area;
                 }
             }
         } else {
-            let mut e = [0.0; 3];
-            for packet in packets.iter() {
-                let ft = ft_dielectric(pi.n.dot(packet.dir), shading.eta);
-                for c in 0..3 {
-                    e[c] += ft * packet.e_cos[c] * tex[c];
-                }
-            }
+            let e = transmitted_irradiance(packets, pi.n, shading.eta, tex);
             let rd = shading.rd_scene((pi.p - g.p).length());
-            let w = ft_dielectric(g.n.dot(g.wo), shading.eta) * shading.norm / pdf;
+            let w = shading.exit_weight(g.n, g.wo) / pdf;
             for c in 0..3 {
                 out[c] = rd[c] * e[c] * w;
             }
@@ -276,5 +276,152 @@ impl Sampler<'_> {
         } else {
             [0.0; 3]
         }
+    }
+}
+
+/// The options of `pathtrace`.
+const OPTIONS: [OptionSpec; 1] = [OptionSpec {
+    name: "spp",
+    value_name: "N",
+    default: "16",
+    help: "BSSRDF samples per pixel sample",
+    kind: OptionKind::Value,
+}];
+
+/// The registry entry.
+pub const METHOD: Method = Method {
+    name: "pathtrace",
+    about: "BSSRDF importance-sampled path tracing (pbrt §15.4)",
+    options: &OPTIONS,
+    build: |o| Ok(Box::new(PathTrace::from_options(o)?)),
+    sweep: Sweep {
+        option: "spp",
+        label: "spp",
+        values: |quick| {
+            if quick {
+                vec![1.0, 4.0, 16.0]
+            } else {
+                vec![1.0, 4.0, 16.0, 64.0]
+            }
+        },
+    },
+};
+
+/// The `pathtrace` integrator and its settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PathTrace {
+    /// BSSRDF samples per G-buffer sample (≥ 1).
+    pub spp: u32,
+}
+
+impl Default for PathTrace {
+    fn default() -> Self {
+        PathTrace { spp: 16 }
+    }
+}
+
+impl PathTrace {
+    /// The settings `options` describe.
+    pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
+        let spp: u32 = o.get(&OPTIONS, "spp")?;
+        if spp == 0 {
+            return Err(Error::Input("--spp must be at least 1".into()));
+        }
+        Ok(PathTrace { spp })
+    }
+}
+
+impl Integrator for PathTrace {
+    fn name(&self) -> &'static str {
+        METHOD.name
+    }
+
+    fn describe(&self) -> String {
+        format!("bssrdf samples per pixel sample: {}", self.spp)
+    }
+
+    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        let scene = frame.scene;
+        let t = std::time::Instant::now();
+        let radii: Vec<Option<ProbeRadii>> = frame
+            .shading
+            .iter()
+            .map(|s| s.as_ref().map(ProbeRadii::new))
+            .collect();
+        let spp = self.spp.max(1);
+        let sampler = |shading, radii| Sampler {
+            geom: &frame.geom,
+            lights: &scene.lights,
+            shading,
+            radii,
+        };
+        let gspp = frame.gbuffer.samples_per_pixel as u64;
+        let results: Vec<(Rgb, Rgb)> = frame
+            .gbuffer
+            .samples
+            .par_iter()
+            .map_init(Scratch::default, |scratch, g| {
+                progress.advance(1);
+                let m = scene.objects[g.object as usize].material;
+                let (Some(sh), Some(rad)) = (frame.shading[m].as_ref(), radii[m].as_ref()) else {
+                    return ([0.0; 3], [0.0; 3]);
+                };
+                let mut r = rng(
+                    frame.seed,
+                    Stream::Path,
+                    g.pixel as u64 * gspp + g.index as u64,
+                );
+                let mut sum = [0.0; 3];
+                let mut sum2 = [0.0; 3];
+                for _ in 0..spp {
+                    let v = sampler(sh, rad).sample(g, &mut r, scratch);
+                    for c in 0..3 {
+                        sum[c] += v[c];
+                        sum2[c] += v[c] * v[c];
+                    }
+                }
+                let k = spp as f64;
+                let mean = sum.map(|s| s / k);
+                // Variance of the mean of this sample's spp estimates.
+                let var = [0, 1, 2].map(|c| {
+                    if spp > 1 {
+                        ((sum2[c] - k * mean[c] * mean[c]) / (k - 1.0)).max(0.0) / k
+                    } else {
+                        0.0
+                    }
+                });
+                (mean, var)
+            })
+            .collect();
+        frame.record("shading", t.elapsed().as_secs_f64());
+        let values: Vec<Rgb> = results.iter().map(|r| r.0).collect();
+        // Pixel standard error: the pixel averages its samples (1/spp_camera each).
+        let gb = &frame.gbuffer;
+        let cs = gb.samples_per_pixel as f64;
+        let se: Vec<Rgb> = (0..gb.pixels())
+            .map(|i| {
+                let mut v = [0.0; 3];
+                for k in gb.offsets[i] as usize..gb.offsets[i + 1] as usize {
+                    for c in 0..3 {
+                        v[c] += results[k].1[c] / (cs * cs);
+                    }
+                }
+                v.map(|x| x.sqrt())
+            })
+            .collect();
+        let shaded = gb
+            .samples
+            .iter()
+            .filter(|g| frame.shading_of(g.object).is_some())
+            .count();
+        Ok(Shaded {
+            values,
+            std_error: Some(se),
+            stats: vec![Stat {
+                name: "paths",
+                value: shaded as f64 * spp as f64,
+            }],
+            layers: Vec::new(),
+        })
     }
 }

@@ -2,187 +2,353 @@
 //! irradiance at each pixel's surface point, blurred in screen space by a separable kernel of
 //! the material's R_d (two 1D passes per term, kernel width from the projected pixel size,
 //! depth- and object-aware taps, per-pixel jitter of the filter axes), then multiplied by
-//! F_t(η, cos θ_o)/(cπ) like every other integrator. Kernels come from `sss-separable`.
-//!
-//! `KernelMethod::Exact2d` replaces the separable pass by the brute-force 2D screen-space
-//! convolution with the full discretised kernel at the same footprint: the ground truth of the
-//! separable approximation itself (as opposed to the world-space `exact` reference, which
-//! also includes what screen space cannot see).
+//! F_t(η, cos θ_o)/(cπ) like every other integrator. The kernel is chosen and built by
+//! [`crate::kernel_choice`]; the pass itself is `sss_separable::screen_space` on plain buffers.
 
-use sss_bssrdf::Bssrdf;
-use sss_separable::{
-    FilterOptions, Kernel2d, Kernel2dSpec, SeparableError, SeparableKernel, TapPlacement, artist,
-    gaussians, guided, preintegrated, svd,
+use super::{
+    Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
 };
-use std::fmt;
-use std::str::FromStr;
+use crate::Error;
+use crate::frame::Frame;
+use crate::irradiance::IrradianceSettings;
+use crate::kernel_choice::{
+    KernelMethod, MaterialKernel, SeparableSettings, build_kernel, filter_options,
+};
+use crate::lights::{Receiver, gather};
+use crate::progress::Progress;
+use crate::rng::{Stream, rng};
+use crate::shading::transmitted_irradiance;
+use rayon::prelude::*;
+use sss_bssrdf::Rgb;
+use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
 
-/// Which separable kernel to use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum KernelMethod {
-    /// Pre-integrated rank-1 kernel (Eq. 4-5).
-    Preintegrated,
-    /// Rank-1 SVD.
-    Svd1,
-    /// Rank-3 SVD (6 passes).
-    Svd3,
-    /// Rank-6 SVD (12 passes).
-    Svd6,
-    /// The artist-friendly two-Gaussian model (Eq. 6) fitted to the material.
-    Artist,
-    /// Guided rank-1 optimisation (Appendix A), exponent `k`.
-    Guided,
-    /// One Gaussian (d'Eon et al. 2007).
-    Gaussians1,
-    /// Six Gaussians (12 passes).
-    Gaussians6,
-    /// The exact 2D screen-space convolution with the full kernel (ground truth).
-    Exact2d,
-}
+/// The options of `separable` (shared with `sss filter`).
+pub const OPTIONS: [OptionSpec; 5] = [
+    OptionSpec {
+        name: "kernel",
+        value_name: "KERNEL",
+        default: "preintegrated",
+        help: "Separable kernel: preintegrated, svd1, svd3, svd6, artist, guided, gaussians1, \
+               gaussians6, or exact2d for the brute-force 2D screen-space convolution",
+        kind: OptionKind::Value,
+    },
+    OptionSpec {
+        name: "taps",
+        value_name: "N",
+        default: "7",
+        help: "taps per 1D pass",
+        kind: OptionKind::Value,
+    },
+    OptionSpec {
+        name: "uniform-taps",
+        value_name: "",
+        default: "",
+        help: "place taps uniformly instead of by importance",
+        kind: OptionKind::Flag,
+    },
+    OptionSpec {
+        name: "k",
+        value_name: "K",
+        default: "2",
+        help: "guided-optimisation exponent k in [0, 4]",
+        kind: OptionKind::Value,
+    },
+    OptionSpec {
+        name: "jitter",
+        value_name: "FRACTION",
+        default: "0.1",
+        help: "fraction of the kernel support within which the filter axes are \
+               rotated per pixel (0 turns the jitter off)",
+        kind: OptionKind::Value,
+    },
+];
 
-impl KernelMethod {
-    /// Every method, in report order.
-    pub const ALL: [KernelMethod; 9] = [
-        KernelMethod::Preintegrated,
-        KernelMethod::Svd1,
-        KernelMethod::Svd3,
-        KernelMethod::Svd6,
-        KernelMethod::Artist,
-        KernelMethod::Guided,
-        KernelMethod::Gaussians1,
-        KernelMethod::Gaussians6,
-        KernelMethod::Exact2d,
-    ];
-
-    /// The command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            KernelMethod::Preintegrated => "preintegrated",
-            KernelMethod::Svd1 => "svd1",
-            KernelMethod::Svd3 => "svd3",
-            KernelMethod::Svd6 => "svd6",
-            KernelMethod::Artist => "artist",
-            KernelMethod::Guided => "guided",
-            KernelMethod::Gaussians1 => "gaussians1",
-            KernelMethod::Gaussians6 => "gaussians6",
-            KernelMethod::Exact2d => "exact2d",
-        }
-    }
-}
-
-impl fmt::Display for KernelMethod {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for KernelMethod {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        KernelMethod::ALL
-            .iter()
-            .copied()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<&str> = KernelMethod::ALL.iter().map(|k| k.name()).collect();
-                format!("unknown kernel `{s}` (known: {})", names.join(", "))
-            })
-    }
-}
-
-/// Settings of the separable integrator.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SeparableSettings {
-    /// The kernel.
-    pub kernel: KernelMethod,
-    /// Taps per 1D pass.
-    pub taps: usize,
-    /// Place taps by importance (the dominant channel's CDF) rather than uniformly. SVD terms
-    /// change sign and are always placed uniformly.
-    pub importance: bool,
-    /// Guided optimisation exponent k in [0, 4].
-    pub k: f64,
-    /// Fraction of the kernel support within which taps are rotated per pixel (0: no jitter).
-    pub jitter: f32,
-}
-
-impl Default for SeparableSettings {
-    fn default() -> Self {
-        SeparableSettings {
-            kernel: KernelMethod::Preintegrated,
-            taps: 7,
-            importance: true,
-            k: 2.0,
-            jitter: 0.1,
-        }
-    }
-}
-
-/// A material's kernel: the separable one, or the full 2D grid for `Exact2d`.
-pub enum MaterialKernel {
-    /// Two 1D passes per term.
-    Separable(SeparableKernel),
-    /// The full discretised kernel.
-    Full(Kernel2d),
-}
-
-/// Builds the kernel of `model` for `settings`; its weights sum to the model's total diffuse
-/// reflectance per channel.
-pub fn build_kernel(
-    model: &dyn Bssrdf,
-    settings: &SeparableSettings,
-) -> Result<MaterialKernel, SeparableError> {
-    let k2 = Kernel2d::from_model(model, &Kernel2dSpec::default())?;
-    let n = settings.taps.max(1);
-    let placement = if settings.importance {
-        TapPlacement::Importance(n)
-    } else {
-        TapPlacement::Uniform(n)
-    };
-    let total = k2.total;
-    let kernel = match settings.kernel {
-        KernelMethod::Exact2d => return Ok(MaterialKernel::Full(k2)),
-        KernelMethod::Preintegrated => preintegrated::kernel(&k2, placement)?,
-        KernelMethod::Svd1 | KernelMethod::Svd3 | KernelMethod::Svd6 => {
-            let rank = match settings.kernel {
-                KernelMethod::Svd1 => 1,
-                KernelMethod::Svd3 => 3,
-                _ => 6,
-            };
-            svd::decompose(&k2)?.separable(rank, TapPlacement::Uniform(n))?
-        }
-        KernelMethod::Artist => {
-            let fit = artist::fit(&preintegrated::profile(&k2))?;
-            artist::kernel(&fit.params, total, placement)?
-        }
-        KernelMethod::Guided => {
-            let opts = guided::GuidedOptions {
-                k: settings.k,
-                ..guided::GuidedOptions::default()
-            };
-            guided::optimize(&k2, &opts)?.kernel(placement)?
-        }
-        KernelMethod::Gaussians1 | KernelMethod::Gaussians6 => {
-            let count = if settings.kernel == KernelMethod::Gaussians1 {
-                1
+/// The registry entry.
+pub const METHOD: Method = Method {
+    name: "separable",
+    about: "Screen-space separable blur (Jimenez et al. 2015)",
+    options: &OPTIONS,
+    build: |o| Ok(Box::new(Separable::from_options(o)?)),
+    sweep: Sweep {
+        option: "taps",
+        label: "taps",
+        values: |quick| {
+            if quick {
+                vec![3.0, 7.0, 15.0]
             } else {
-                6
-            };
-            let fits = gaussians::fit_model(model, count)?;
-            let fit = fits
-                .last()
-                .ok_or_else(|| SeparableError::InvalidArgument("no Gaussian fit".into()))?;
-            fit.kernel(total, placement)?
-        }
+                vec![3.0, 7.0, 15.0, 31.0]
+            }
+        },
+    },
+};
+
+/// Reads and checks the kernel options (`sss render --method separable`, `sss filter`).
+pub fn kernel_settings(o: &MethodOptions) -> Result<SeparableSettings, Error> {
+    let s = SeparableSettings {
+        kernel: o.get::<KernelMethod>(&OPTIONS, "kernel")?,
+        taps: o.get(&OPTIONS, "taps")?,
+        importance: !o.flag("uniform-taps"),
+        k: o.get(&OPTIONS, "k")?,
+        jitter: o.get(&OPTIONS, "jitter")?,
     };
-    Ok(MaterialKernel::Separable(kernel))
+    s.check()?;
+    Ok(s)
 }
 
-/// The filter options of a render.
-pub fn filter_options(settings: &SeparableSettings, seed: u64) -> FilterOptions {
-    FilterOptions {
-        jitter_radius: settings.jitter,
-        seed,
-        ..FilterOptions::default()
+/// The `separable` integrator and its settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Separable {
+    /// The kernel and filter.
+    pub kernel: SeparableSettings,
+    /// Light samples per quad or environment light when gathering each pixel's irradiance.
+    pub light_samples: u32,
+}
+
+impl Default for Separable {
+    fn default() -> Self {
+        Separable {
+            kernel: SeparableSettings::default(),
+            light_samples: IrradianceSettings::default().light_samples,
+        }
     }
+}
+
+impl Separable {
+    /// The settings `options` describe.
+    pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
+        Ok(Separable {
+            kernel: kernel_settings(o)?,
+            ..Separable::default()
+        })
+    }
+}
+
+/// Names of the screen-space input layers (what `sss filter` reads back).
+pub const LAYERS: [&str; 2] = ["irradiance", "surface"];
+
+impl Integrator for Separable {
+    fn name(&self) -> &'static str {
+        METHOD.name
+    }
+
+    fn describe(&self) -> String {
+        let s = &self.kernel;
+        format!(
+            "kernel {}, {} {} taps per pass, jitter {}",
+            s.kernel,
+            s.taps,
+            if s.importance {
+                "importance-sampled"
+            } else {
+                "uniform"
+            },
+            s.jitter
+        )
+    }
+
+    fn layer_names(&self) -> &'static [&'static str] {
+        &LAYERS
+    }
+
+    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        let scene = frame.scene;
+        // Fresnel-transmitted, textured irradiance at every translucent pixel sample.
+        let irradiance: Vec<Rgb> = frame.timed("irradiance", || {
+            frame
+                .gbuffer
+                .samples
+                .par_iter()
+                .enumerate()
+                .map(|(k, g)| {
+                    let Some(sh) = frame.shading_of(g.object) else {
+                        return [0.0; 3];
+                    };
+                    let mut r = rng(frame.seed, Stream::Irradiance, (1u64 << 62) ^ k as u64);
+                    let mut packets = Vec::new();
+                    let at = Receiver {
+                        p: g.p,
+                        n: g.n,
+                        ng: g.ng,
+                    };
+                    gather(
+                        &frame.geom,
+                        &scene.lights,
+                        at,
+                        self.light_samples,
+                        &mut r,
+                        &mut packets,
+                    );
+                    transmitted_irradiance(&mut packets, g.n, sh.eta, sh.texture_at(g.p))
+                })
+                .collect()
+        });
+        // One kernel per material in use.
+        let kernels = frame.timed("kernels", || -> Result<Vec<_>, Error> {
+            let mut kernels: Vec<Option<MaterialKernel>> = Vec::new();
+            for (m, sh) in frame.shading.iter().enumerate() {
+                kernels.push(match sh {
+                    Some(sh) => Some(build_kernel(sh.bssrdf(), &self.kernel).map_err(|e| {
+                        Error::Input(format!(
+                            "material `{}`: cannot build the {} kernel: {e}",
+                            scene.materials[m].name, self.kernel.kernel
+                        ))
+                    })?),
+                    None => None,
+                });
+            }
+            Ok(kernels)
+        })?;
+        // Filter each material's pixels.
+        let t = std::time::Instant::now();
+        let gb = &frame.gbuffer;
+        let (w, h) = (gb.width as usize, gb.height as usize);
+        let screen = screen_buffers(frame, &irradiance);
+        let mut values = vec![[0.0; 3]; gb.samples.len()];
+        let opts = filter_options(&self.kernel, frame.seed);
+        let mut taps = 0usize;
+        for (m, kernel) in kernels.iter().enumerate() {
+            let (Some(kernel), Some(sh)) = (kernel, frame.shading[m].as_ref()) else {
+                continue;
+            };
+            let u = sh.units_per_mm;
+            let mut e = vec![[0.0f32; 3]; w * h];
+            let mut depth = vec![0.0f32; w * h];
+            let mut mask = vec![NO_OBJECT; w * h];
+            let mut mm = vec![0.0f32; w * h];
+            for i in 0..w * h {
+                let o = screen.object[i];
+                if o == NO_OBJECT || scene.objects[o as usize].material != m {
+                    continue;
+                }
+                mask[i] = o;
+                depth[i] = (screen.depth[i] / u) as f32;
+                mm[i] = (screen.footprint[i] / u) as f32;
+                e[i] = screen.irradiance[i].map(|v| v as f32);
+            }
+            let input = ScreenInput {
+                width: w,
+                height: h,
+                irradiance: &e,
+                depth: &depth,
+                mask: &mask,
+                mm_per_pixel: &mm,
+            };
+            let pixels = mask.iter().filter(|&&o| o != NO_OBJECT).count();
+            let filtered = match kernel {
+                MaterialKernel::Separable(k) => {
+                    taps += pixels * k.taps_per_pixel();
+                    screen_space::filter(&input, k, &opts)
+                }
+                MaterialKernel::Full(k2) => {
+                    taps += pixels * k2.cells * k2.cells;
+                    convolve2d::exact(&input, k2, &opts)
+                }
+            }
+            .map_err(|e| Error::Input(format!("separable filter: {e}")))?;
+            for (k, g) in gb.samples.iter().enumerate() {
+                if scene.objects[g.object as usize].material != m
+                    || screen.object[g.pixel as usize] != g.object
+                {
+                    continue;
+                }
+                let f = filtered[g.pixel as usize];
+                let s = sh.exit_weight(g.n, g.wo);
+                values[k] = [f[0] as f64 * s, f[1] as f64 * s, f[2] as f64 * s];
+            }
+        }
+        progress.advance(gb.samples.len() as u64);
+        frame.record("shading", t.elapsed().as_secs_f64());
+        Ok(Shaded {
+            values,
+            std_error: None,
+            stats: vec![Stat {
+                name: "taps",
+                value: taps as f64,
+            }],
+            layers: screen.layers(),
+        })
+    }
+}
+
+/// The per-pixel inputs of a screen-space pass, in scene units: what `sss render --gbuffer`
+/// writes and `sss filter` reads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScreenBuffers {
+    /// Fresnel-transmitted, textured irradiance, averaged over the pixel's samples on its
+    /// object (0 off translucent objects).
+    pub irradiance: Vec<Rgb>,
+    /// Distance from the camera (scene units).
+    pub depth: Vec<f64>,
+    /// World-space size of one pixel at that distance (scene units).
+    pub footprint: Vec<f64>,
+    /// Translucent object per pixel (its first translucent sample's), `u32::MAX` for none.
+    pub object: Vec<u32>,
+}
+
+impl ScreenBuffers {
+    /// As EXR layers ([`LAYERS`]): `irradiance`, and `surface` = (depth, footprint, object id
+    /// + 1 with 0 for none; EXR values are kept non-negative).
+    pub fn layers(&self) -> Vec<Layer> {
+        let surface: Vec<Rgb> = (0..self.depth.len())
+            .map(|i| {
+                let id = if self.object[i] == u32::MAX {
+                    0.0
+                } else {
+                    self.object[i] as f64 + 1.0
+                };
+                [self.depth[i], self.footprint[i], id]
+            })
+            .collect();
+        vec![
+            Layer {
+                name: LAYERS[0],
+                pixels: self.irradiance.clone(),
+            },
+            Layer {
+                name: LAYERS[1],
+                pixels: surface,
+            },
+        ]
+    }
+}
+
+/// Per pixel: the first translucent sample's object, and the average irradiance, depth and
+/// footprint of the pixel's samples on that object.
+pub fn screen_buffers(frame: &Frame<'_>, irradiance: &[Rgb]) -> ScreenBuffers {
+    let gb = &frame.gbuffer;
+    let n = gb.pixels();
+    let mut b = ScreenBuffers {
+        irradiance: vec![[0.0; 3]; n],
+        depth: vec![0.0; n],
+        footprint: vec![0.0; n],
+        object: vec![u32::MAX; n],
+    };
+    for i in 0..n {
+        let range = gb.offsets[i] as usize..gb.offsets[i + 1] as usize;
+        let Some(first) = range
+            .clone()
+            .find(|&k| frame.shading_of(gb.samples[k].object).is_some())
+        else {
+            continue;
+        };
+        let o = gb.samples[first].object;
+        let mut count = 0.0;
+        for k in range {
+            let g = &gb.samples[k];
+            if g.object != o {
+                continue;
+            }
+            for c in 0..3 {
+                b.irradiance[i][c] += irradiance[k][c];
+            }
+            b.depth[i] += g.distance;
+            b.footprint[i] += g.footprint;
+            count += 1.0;
+        }
+        b.object[i] = o;
+        b.irradiance[i] = b.irradiance[i].map(|v| v / count);
+        b.depth[i] /= count;
+        b.footprint[i] /= count;
+    }
+    b
 }

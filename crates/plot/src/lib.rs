@@ -1,4 +1,8 @@
-//! Line and scatter plots to PNG or SVG, for radial profiles and error reports.
+//! # sss-plot: line plots and error maps for the toolkit's reports
+//!
+//! Line and scatter plots to PNG or SVG, for radial profiles and error reports, and
+//! false-colour per-pixel error maps ([`write_error_map`]). Use it when you want the pictures
+//! `sss` and `cargo xtask compare` draw; the renderer itself does not depend on it.
 //!
 //! The API is plain data: build [`Series`] (a name, points, a colour, an optional symmetric
 //! error per point), group them in [`Panel`]s and call [`line_plot`] (one panel) or
@@ -12,6 +16,21 @@
 //!   below the largest value; points below that are dropped too.
 //! - The image is drawn to a temporary file in the same directory and renamed into place, so
 //!   a reader never sees a half-written plot. Every error names the file.
+//!
+//! ```
+//! use sss_plot::{Series, SeriesStyle, line_plot};
+//!
+//! let dir = std::env::temp_dir().join(format!("sss-plot-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir).unwrap();
+//! let points = (1..50).map(|i| (i as f64 * 0.1, (-(i as f64) * 0.1).exp())).collect();
+//! let series = Series::line("R_d", points);
+//! line_plot(&dir.join("rd.svg"), "profile", "r (mm)", "R_d", &[series], false, true).unwrap();
+//! assert!(std::fs::read_to_string(dir.join("rd.svg")).unwrap().contains("<svg"));
+//! # std::fs::remove_dir_all(&dir).unwrap();
+//! ```
+//!
+//! ## Papers
+//! None; the error-map colour ramp samples the inferno map (van der Walt & Smith, matplotlib).
 
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
@@ -19,6 +38,9 @@ use plotters::prelude::*;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
+
+mod error_map;
+pub use error_map::{false_colour, write_error_map};
 
 /// A log y axis spans at most this many decades below its largest value.
 pub const MAX_LOG_DECADES: f64 = 10.0;
@@ -237,67 +259,47 @@ pub fn panel_plot(
         path: path.to_path_buf(),
         message,
     };
-    let tmp = temp_path(path, format);
-    // Creating the file first gives a plain I/O message for a bad directory.
-    std::fs::File::create(&tmp).map_err(|e| draw_err(e.to_string()))?;
-    let result = match format {
-        PlotFormat::Png => {
-            let root = BitMapBackend::new(&tmp, size).into_drawing_area();
-            draw_all(&root, title, panels, rows, columns).and_then(|()| {
-                root.present()
-                    .map_err(|e| format!("encoding the image failed: {e}"))
-            })
-        }
-        PlotFormat::Svg => {
-            let mut svg = String::new();
-            let drawn = {
-                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-                draw_all(&root, title, panels, rows, columns)
-                    .and_then(|()| root.present().map_err(|e| e.to_string()))
-            };
-            drawn.and_then(|()| std::fs::write(&tmp, &svg).map_err(|e| e.to_string()))
-        }
-    };
-    if let Err(message) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(draw_err(message));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        draw_err(e.to_string())
-    })
+    sss_util::write_atomic_with(
+        path,
+        |tmp| {
+            // Creating the file first gives a plain I/O message for a bad directory.
+            std::fs::File::create(tmp).map_err(|e| draw_err(e.to_string()))?;
+            match format {
+                PlotFormat::Png => {
+                    let root = BitMapBackend::new(tmp, size).into_drawing_area();
+                    draw_all(&root, title, panels, rows, columns).and_then(|()| {
+                        root.present()
+                            .map_err(|e| format!("encoding the image failed: {e}"))
+                    })
+                }
+                PlotFormat::Svg => {
+                    let mut svg = String::new();
+                    let drawn = {
+                        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                        draw_all(&root, title, panels, rows, columns)
+                            .and_then(|()| root.present().map_err(|e| e.to_string()))
+                    };
+                    drawn.and_then(|()| std::fs::write(tmp, &svg).map_err(|e| e.to_string()))
+                }
+            }
+            .map_err(draw_err)
+        },
+        |e| draw_err(e.to_string()),
+    )
 }
 
 /// Checks that a plot can be written to `path` (a supported extension, a writable
 /// directory) without drawing it: creates and removes the temporary file. Call it before a
 /// long computation whose result is to be plotted.
 pub fn check_writable(path: &Path) -> Result<(), PlotError> {
-    let format = PlotFormat::from_path(path)?;
-    let tmp = temp_path(path, format);
+    PlotFormat::from_path(path)?;
+    let tmp = sss_util::temp_path(path);
     std::fs::File::create(&tmp).map_err(|e| PlotError::Draw {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
     let _ = std::fs::remove_file(&tmp);
     Ok(())
-}
-
-/// `dir/.name.<pid>.tmp.<ext>`: same directory (so rename is atomic), same extension (the
-/// bitmap encoder picks the format by it).
-fn temp_path(path: &Path, format: PlotFormat) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "plot".into());
-    let ext = match format {
-        PlotFormat::Png => "png",
-        PlotFormat::Svg => "svg",
-    };
-    let tmp_name = format!(".{name}.{}.tmp.{ext}", std::process::id());
-    match path.parent() {
-        Some(dir) => dir.join(tmp_name),
-        None => PathBuf::from(tmp_name),
-    }
 }
 
 /// Registers the embedded font with plotters (once); other drawing code calls this before

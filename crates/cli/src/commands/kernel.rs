@@ -9,15 +9,13 @@
 //! passes and multiplies by R, or by its own albedo, afterwards). Multi-term kernels export
 //! each term's horizontal and vertical taps as stored (their products sum to R).
 
-use crate::Error;
-use crate::cli::MediumArgs;
-use crate::integrators::separable::{
-    KernelMethod, MaterialKernel, SeparableSettings, build_kernel,
-};
-use crate::profile::{MediumSpec, build_medium};
-use crate::render_cli::check_separable_args;
+use crate::args::MediumArgs;
+use crate::profile_table::{MediumSpec, build_medium};
 use clap::{Args, ValueEnum};
 use sss_bssrdf::{ModelKind, Rgb, make_model};
+use sss_render::Error;
+use sss_render::kernel_choice::check_separable_options;
+use sss_render::kernel_choice::{KernelMethod, MaterialKernel, SeparableSettings, build_kernel};
 use sss_separable::{Kernel1d, SeparableKernel, TapPlacement, artist};
 use std::fmt::Write as _;
 
@@ -164,8 +162,8 @@ fn float4_array(k: &Kernel1d, glsl: bool, name: &str) -> String {
 }
 
 /// Runs `sss kernel`: the kernel text for stdout.
-pub fn run_kernel(args: &KernelArgs) -> Result<String, Error> {
-    check_separable_args(args.taps, args.k, 0.0)?;
+pub fn run(args: &KernelArgs) -> Result<String, Error> {
+    check_separable_options(args.taps, args.k, 0.0)?;
     if args.method == KernelMethod::Exact2d {
         return Err(Error::Input(
             "--method exact2d is the full 2D kernel, not a separable one; choose preintegrated, svd1, svd3, svd6, artist, guided, gaussians1 or gaussians6".into(),

@@ -6,7 +6,7 @@
 //! ([`ProfileTable::plot`]).
 //!
 //! ```
-//! use sss_render::profile::{compute, MediumSpec, ProfileModel, ProfileRequest};
+//! use sss_cli::profile_table::{compute, MediumSpec, ProfileModel, ProfileRequest};
 //! let req = ProfileRequest {
 //!     steps: 4,
 //!     ..ProfileRequest::new(ProfileModel::Pbd, MediumSpec::Preset("skin1".into()), 5.0)
@@ -19,9 +19,9 @@
 //! ```
 
 use crate::Error;
-use crate::plot::{CHANNEL_COLORS, ErrorStyle, Series, line_plot};
 use sss_bssrdf::monte_carlo::{self, McConfig};
 use sss_bssrdf::{Medium, ModelKind, Rgb, make_model, presets};
+use sss_plot::{CHANNEL_COLORS, ErrorStyle, PlotError, Series, line_plot};
 use std::io::Write;
 use std::path::Path;
 
@@ -347,7 +347,7 @@ impl ProfileTable {
 
     /// Draws the three channels on a log y axis (log x too when `log_x`), Monte Carlo with
     /// its standard errors as a band, to `path` (`.png` or `.svg`).
-    pub fn plot(&self, path: &Path, log_x: bool) -> Result<(), Error> {
+    pub fn plot(&self, path: &Path, log_x: bool) -> Result<(), PlotError> {
         let names = ["red", "green", "blue"];
         let series: Vec<Series> = (0..3)
             .map(|ch| {
@@ -366,8 +366,7 @@ impl ProfileTable {
             })
             .collect();
         let title = format!("Rd(r), {}: {}", self.model.name(), self.medium_label);
-        line_plot(path, &title, "r (mm)", "Rd (1/mm²)", &series, log_x, true)?;
-        Ok(())
+        line_plot(path, &title, "r (mm)", "Rd (1/mm²)", &series, log_x, true)
     }
 }
 

@@ -4,14 +4,16 @@
 //! where no translucent object is seen). Outputs the diffuse exitance E ∗ R_d per pixel (same
 //! unit as the irradiance; multiply by F_t(η, cos θ_o)/(cπ) for radiance).
 
-use crate::Error;
-use crate::cli::MediumArgs;
-use crate::image::{auto_exposure, read_exr, write_exr, write_png};
-use crate::integrators::separable::{MaterialKernel, build_kernel, filter_options};
-use crate::profile::build_medium;
-use crate::render_cli::{SeparableArgs, check_output};
+use crate::args::MediumArgs;
+use crate::commands::render::check_output;
+use crate::method_flags::{MethodFlags, SeparableOnly};
+use crate::profile_table::build_medium;
 use clap::Args;
 use sss_bssrdf::{ModelKind, Rgb, make_model};
+use sss_render::Error;
+use sss_render::image::{auto_exposure, read_exr, write_exr, write_png};
+use sss_render::integrators::separable::kernel_settings;
+use sss_render::kernel_choice::{MaterialKernel, build_kernel, filter_options};
 use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
 use std::path::PathBuf;
 
@@ -31,7 +33,7 @@ pub struct FilterArgs {
     pub model: ModelKind,
     /// The kernel and filter options.
     #[command(flatten)]
-    pub separable: SeparableArgs,
+    pub separable: MethodFlags<SeparableOnly>,
     /// Seed of the per-pixel rotations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -44,8 +46,8 @@ pub struct FilterArgs {
 }
 
 /// Runs `sss filter`; returns a one-line summary.
-pub fn run_filter(args: &FilterArgs) -> Result<String, Error> {
-    let settings = args.separable.settings()?;
+pub fn run(args: &FilterArgs) -> Result<String, Error> {
+    let settings = kernel_settings(&args.separable.options)?;
     if !(args.units_per_mm.is_finite() && args.units_per_mm > 0.0) {
         return Err(Error::Input(format!(
             "--units-per-mm must be positive, got {}",

@@ -1,0 +1,98 @@
+//! `sss diff`: error figures of one render against another (RMSE, relative RMSE, fraction of
+//! pixels within a relative error, mean ratio per channel; [`sss_render::metrics`]) and a
+//! false-colour error map.
+
+use crate::commands::render::check_output;
+use crate::plot_error;
+use clap::Args;
+use sss_bssrdf::Rgb;
+use sss_plot::write_error_map;
+use sss_render::Error;
+use sss_render::image::read_exr;
+use sss_render::metrics::{error_figures, mean_ratio_rgb, relative_errors};
+use std::path::{Path, PathBuf};
+
+/// Arguments of `sss diff`.
+#[derive(Debug, Args)]
+pub struct DiffArgs {
+    /// The render to judge (OpenEXR from `sss render`).
+    pub image: PathBuf,
+    /// The reference (OpenEXR from `sss render`).
+    pub reference: PathBuf,
+    /// Which layer to compare.
+    #[arg(long, default_value = "subsurface")]
+    pub layer: String,
+    /// False-colour error map (PNG) of the relative error per pixel.
+    #[arg(long, value_name = "FILE.png")]
+    pub png: Option<PathBuf>,
+    /// Relative-error threshold for the fraction of pixels within it.
+    #[arg(long, default_value_t = 0.05)]
+    pub eps: f64,
+}
+
+/// Runs `sss diff`.
+pub fn run(args: &DiffArgs) -> Result<String, Error> {
+    if let Some(p) = &args.png {
+        check_output(p, "png")?;
+    }
+    let (w, h, a) = read_exr(&args.image)?;
+    let (wr, hr, b) = read_exr(&args.reference)?;
+    if (w, h) != (wr, hr) {
+        return Err(Error::Input(format!(
+            "{} is {w}x{h} but {} is {wr}x{hr}",
+            args.image.display(),
+            args.reference.display()
+        )));
+    }
+    let pick = |layers: &[(String, Vec<Rgb>)], path: &Path| -> Result<Vec<Rgb>, Error> {
+        layers
+            .iter()
+            .find(|(n, _)| *n == args.layer)
+            .map(|(_, d)| d.clone())
+            .ok_or_else(|| {
+                let names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
+                Error::Input(format!(
+                    "{}: no layer `{}` (it has: {})",
+                    path.display(),
+                    args.layer,
+                    names.join(", ")
+                ))
+            })
+    };
+    let img = pick(&a, &args.image)?;
+    let reference = pick(&b, &args.reference)?;
+    let pixels: Vec<usize> = (0..img.len())
+        .filter(|&i| reference[i].iter().chain(img[i].iter()).any(|v| *v > 0.0))
+        .collect();
+    let f = error_figures(&img, &reference, &pixels, args.eps);
+    if let Some(p) = &args.png {
+        let rel = relative_errors(&img, &reference, &pixels);
+        let mut values = vec![None; img.len()];
+        for (k, &i) in pixels.iter().enumerate() {
+            values[i] = Some(rel[k]);
+        }
+        let max = 4.0 * args.eps;
+        write_error_map(
+            p,
+            w,
+            h,
+            &values,
+            max,
+            &format!("relative error, layer {}", args.layer),
+            "|a-b|/b",
+        )
+        .map_err(plot_error)?;
+    }
+    let ratio = mean_ratio_rgb(&img, &reference, &pixels);
+    Ok(format!(
+        "pixels {}\nrmse {:.6e}\nrel_rmse {:.6e}\nfrac_within_{} {:.4}\nmean_ratio {:.5} {:.5} {:.5}\n",
+        pixels.len(),
+        f.rmse,
+        f.rel_rmse,
+        args.eps,
+        f.frac_within_eps,
+        ratio[0],
+        ratio[1],
+        ratio[2]
+    ))
+}

@@ -1,0 +1,84 @@
+//! `sss profile`: the radial profile R_d(r) of a model (or the Monte Carlo reference) as CSV,
+//! optionally plotted.
+
+use crate::args::MediumArgs;
+use crate::plot_error;
+use crate::profile_table::{ProfileModel, ProfileRequest, compute};
+use clap::Args;
+use sss_render::Error;
+use std::path::PathBuf;
+
+/// Arguments of `sss profile`.
+#[derive(Debug, Args)]
+pub struct ProfileArgs {
+    /// The model, or the Monte Carlo reference.
+    #[arg(long, value_enum)]
+    pub model: ProfileModel,
+    /// The medium.
+    #[command(flatten)]
+    pub medium: MediumArgs,
+    /// Largest radius in mm.
+    #[arg(long, allow_hyphen_values = true)]
+    pub r_max: f64,
+    /// Number of radii (or Monte Carlo bins).
+    #[arg(long)]
+    pub steps: usize,
+    /// Log-spaced radii from r_max·1e-4 to r_max (models only).
+    #[arg(long)]
+    pub log: bool,
+    /// Also draw the profile to this file (.png or .svg).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    /// Monte Carlo photons per channel.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub photons: u64,
+    /// Monte Carlo seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+impl ProfileArgs {
+    /// The library request these arguments describe.
+    pub fn request(&self) -> Result<ProfileRequest, Error> {
+        let medium = self.medium.spec()?;
+        Ok(ProfileRequest {
+            model: self.model,
+            medium,
+            eta: self.medium.eta,
+            r_max: self.r_max,
+            steps: self.steps,
+            log: self.log,
+            photons: self.photons,
+            seed: self.seed,
+        })
+    }
+}
+
+/// Runs `sss profile`: the CSV bytes for stdout (after the plot, if any, is written).
+pub fn run(args: &ProfileArgs) -> Result<Vec<u8>, Error> {
+    let req = args.request()?;
+    if let Some(path) = &args.plot {
+        // Fail on a bad extension or directory before a long computation.
+        sss_plot::check_writable(path).map_err(plot_error)?;
+    }
+    let bar = (req.model == ProfileModel::MonteCarlo)
+        .then(|| crate::progress::bar(3 * req.photons, "photons"));
+    let table = compute(&req, &|n| {
+        if let Some(b) = &bar {
+            b.set_position(n);
+        }
+    });
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let table = table?;
+    if let Some(path) = &args.plot {
+        table.plot(path, req.log).map_err(plot_error)?;
+    }
+    let mut buf = Vec::new();
+    table.write_csv(&mut buf).map_err(|source| Error::Io {
+        what: "formatting the CSV".into(),
+        source,
+    })?;
+    Ok(buf)
+}

@@ -1,0 +1,167 @@
+//! Command-line flags generated from the method registry (`sss_render::integrators::METHODS`):
+//! every option a method declares becomes `--<name>`, so a new method's flags appear in
+//! `sss render` (and its help) without touching this crate. Only the values actually given
+//! are recorded; defaults come from the method's own declaration.
+
+use clap::builder::PossibleValuesParser;
+use clap::{Arg, ArgAction, ArgMatches, Command};
+use sss_render::integrators::{METHODS, MethodOptions, OptionKind, OptionSpec};
+use std::marker::PhantomData;
+
+/// Which options a flag set offers.
+pub trait FlagSet {
+    /// The options, each once, with the methods that use it.
+    fn specs() -> Vec<(OptionSpec, Vec<&'static str>)>;
+}
+
+/// Every option of every registered method (`sss render`).
+#[derive(Clone, Debug, Default)]
+pub struct AllMethods;
+
+impl FlagSet for AllMethods {
+    fn specs() -> Vec<(OptionSpec, Vec<&'static str>)> {
+        let mut out: Vec<(OptionSpec, Vec<&'static str>)> = Vec::new();
+        for m in METHODS {
+            for spec in m.options {
+                match out.iter_mut().find(|(s, _)| s.name == spec.name) {
+                    Some((_, users)) => users.push(m.name),
+                    None => out.push((*spec, vec![m.name])),
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The separable method's options alone (`sss filter`).
+#[derive(Clone, Debug, Default)]
+pub struct SeparableOnly;
+
+impl FlagSet for SeparableOnly {
+    fn specs() -> Vec<(OptionSpec, Vec<&'static str>)> {
+        sss_render::integrators::separable::OPTIONS
+            .iter()
+            .map(|s| (*s, vec!["separable"]))
+            .collect()
+    }
+}
+
+/// The method options given on the command line.
+#[derive(Clone, Debug, Default)]
+pub struct MethodFlags<S: FlagSet> {
+    /// Values given, by option name.
+    pub options: MethodOptions,
+    set: PhantomData<S>,
+}
+
+/// The names of the registered methods, for `--method`.
+pub fn method_parser() -> PossibleValuesParser {
+    PossibleValuesParser::new(METHODS.iter().map(|m| m.name))
+}
+
+fn arg(spec: &OptionSpec, users: &[&str]) -> Arg {
+    let used_by = if users.len() == METHODS.len() {
+        String::new()
+    } else {
+        format!(" ({})", users.join(", "))
+    };
+    let arg = Arg::new(spec.name).long(spec.name);
+    match spec.kind {
+        OptionKind::Flag => arg
+            .action(ArgAction::SetTrue)
+            .help(format!("{}{used_by}", spec.help)),
+        OptionKind::Value => arg
+            .action(ArgAction::Set)
+            .value_name(spec.value_name)
+            .allow_hyphen_values(true)
+            .help(format!(
+                "{}{used_by} [default: {}]",
+                spec.help, spec.default
+            )),
+    }
+}
+
+impl<S: FlagSet> clap::FromArgMatches for MethodFlags<S> {
+    fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
+        let mut flags = MethodFlags {
+            options: MethodOptions::new(),
+            set: PhantomData,
+        };
+        flags.update_from_arg_matches(m)?;
+        Ok(flags)
+    }
+
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
+        for (spec, _) in S::specs() {
+            match spec.kind {
+                OptionKind::Flag => {
+                    if m.get_flag(spec.name) {
+                        self.options.set(spec.name, "");
+                    }
+                }
+                OptionKind::Value => {
+                    if let Some(v) = m.get_one::<String>(spec.name) {
+                        self.options.set(spec.name, v);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<S: FlagSet> clap::Args for MethodFlags<S> {
+    fn augment_args(mut cmd: Command) -> Command {
+        for (spec, users) in S::specs() {
+            cmd = cmd.arg(arg(&spec, &users));
+        }
+        cmd
+    }
+
+    fn augment_args_for_update(cmd: Command) -> Command {
+        Self::augment_args(cmd)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Options shared by several methods must mean the same thing in each.
+    #[test]
+    fn shared_options_agree_between_methods() {
+        for m in METHODS {
+            for spec in m.options {
+                for other in METHODS {
+                    if let Some(o) = other.options.iter().find(|o| o.name == spec.name) {
+                        assert_eq!(
+                            o, spec,
+                            "--{} differs between {} and {}",
+                            spec.name, m.name, other.name
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Every method builds from its declared defaults, and every sweep value builds too.
+    #[test]
+    fn every_method_builds_from_defaults_and_sweep_values() {
+        for m in METHODS {
+            let i = (m.build)(&MethodOptions::new()).unwrap();
+            assert_eq!(i.name(), m.name);
+            assert!(
+                m.options.iter().any(|o| o.name == m.sweep.option),
+                "{}",
+                m.name
+            );
+            for quick in [false, true] {
+                for v in (m.sweep.values)(quick) {
+                    let opts = MethodOptions::new().with(m.sweep.option, v);
+                    (m.build)(&opts).unwrap_or_else(|e| panic!("{} {v}: {e}", m.name));
+                }
+            }
+        }
+    }
+}

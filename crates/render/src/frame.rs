@@ -1,0 +1,195 @@
+//! The prepared frame every integrator works on: the scene, one BVH per object, the G-buffer,
+//! the translucent objects the camera sees with their materials' shading data, and (built on
+//! first request, then shared) the irradiance samples of those objects. It also keeps the
+//! timings of its stages.
+
+use crate::gbuffer::{GBuffer, GSample};
+use crate::geometry::SceneGeometry;
+use crate::irradiance::{self, IrradianceSettings, ObjectSamples};
+use crate::lights::{Receiver, gather};
+use crate::rng::{Stream, rng};
+use crate::shading::{TranslucentShading, shading_for};
+use sss_bssrdf::Rgb;
+use sss_scene::{MaterialKind, Scene};
+use std::f64::consts::PI;
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Instant;
+
+/// Wall-clock time of one stage.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage {
+    /// Stage name (`bvh`, `gbuffer`, `models`, `samples`, `shading`, ...).
+    pub name: &'static str,
+    /// Seconds.
+    pub seconds: f64,
+}
+
+/// Irradiance samples built for one setting.
+struct CachedSamples {
+    settings: IrradianceSettings,
+    samples: Arc<Vec<ObjectSamples>>,
+}
+
+/// The parts of a render every integrator shares. Built by [`Frame::prepare`]; integrators
+/// read it (and may ask for irradiance samples) through a shared reference.
+pub struct Frame<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Seed of every random stream of the render.
+    pub seed: u64,
+    /// Per-object BVHs.
+    pub geom: SceneGeometry,
+    /// The camera's hits.
+    pub gbuffer: GBuffer,
+    /// Translucent objects with at least one G-buffer sample, ascending.
+    pub visible: Vec<u32>,
+    /// Shading data per material (None for materials no visible translucent object uses).
+    pub shading: Vec<Option<TranslucentShading>>,
+    stages: Mutex<Vec<Stage>>,
+    samples: Mutex<Option<CachedSamples>>,
+}
+
+impl<'a> Frame<'a> {
+    /// Builds the BVHs, casts the camera rays and builds the models of the translucent
+    /// materials the camera sees.
+    pub fn prepare(scene: &'a Scene, seed: u64) -> Frame<'a> {
+        let mut stages = Vec::new();
+        let geom = timed_into(&mut stages, "bvh", || SceneGeometry::new(scene));
+        let gbuffer = timed_into(&mut stages, "gbuffer", || GBuffer::new(scene, &geom, seed));
+        let mut seen = vec![false; scene.objects.len()];
+        for g in &gbuffer.samples {
+            seen[g.object as usize] = true;
+        }
+        let visible: Vec<u32> = (0..scene.objects.len() as u32)
+            .filter(|&o| seen[o as usize] && scene.translucent(o as usize).is_some())
+            .collect();
+        let shading = timed_into(&mut stages, "models", || shading_for(scene, &visible));
+        Frame {
+            scene,
+            seed,
+            geom,
+            gbuffer,
+            visible,
+            shading,
+            stages: Mutex::new(stages),
+            samples: Mutex::new(None),
+        }
+    }
+}
+
+impl Frame<'_> {
+    /// Runs `f` and records its wall-clock time as stage `name`.
+    pub fn timed<T>(&self, name: &'static str, f: impl FnOnce() -> T) -> T {
+        let t = Instant::now();
+        let v = f();
+        self.record(name, t.elapsed().as_secs_f64());
+        v
+    }
+
+    /// Records `seconds` as stage `name`.
+    pub fn record(&self, name: &'static str, seconds: f64) {
+        self.stages
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push(Stage { name, seconds });
+    }
+
+    /// The stages recorded so far, in order.
+    pub fn stages(&self) -> Vec<Stage> {
+        self.stages
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+
+    /// The shading data of the translucent object `object`, if it is translucent and visible.
+    pub fn shading_of(&self, object: u32) -> Option<&TranslucentShading> {
+        self.shading[self.scene.objects[object as usize].material].as_ref()
+    }
+
+    /// The irradiance samples of the visible translucent objects for `settings`: placed and lit
+    /// on the first request (timed as stage `samples`), then shared by later requests with the
+    /// same settings. A request with other settings builds (and keeps) a new set.
+    pub fn irradiance_samples(&self, settings: &IrradianceSettings) -> Arc<Vec<ObjectSamples>> {
+        let mut cache = self.samples.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(c) = cache.as_ref()
+            && c.settings == *settings
+        {
+            return Arc::clone(&c.samples);
+        }
+        let samples = Arc::new(self.timed("samples", || {
+            irradiance::compute(self.scene, &self.geom, &self.visible, settings, self.seed)
+        }));
+        *cache = Some(CachedSamples {
+            settings: *settings,
+            samples: Arc::clone(&samples),
+        });
+        samples
+    }
+
+    /// The irradiance samples built so far (count summed over objects, and each object's
+    /// spacing), or `(0, [])` when no integrator asked for them.
+    pub fn samples_built(&self) -> (usize, Vec<(u32, f64)>) {
+        let cache = self.samples.lock().unwrap_or_else(PoisonError::into_inner);
+        match cache.as_ref() {
+            Some(c) => (
+                c.samples.iter().map(|s| s.samples.len()).sum(),
+                c.samples.iter().map(|s| (s.object, s.spacing)).collect(),
+            ),
+            None => (0, Vec::new()),
+        }
+    }
+
+    /// The irradiance samples of object `object` in `samples`, indexed by object.
+    pub fn samples_by_object<'s>(
+        &self,
+        samples: &'s [ObjectSamples],
+    ) -> Vec<Option<&'s ObjectSamples>> {
+        (0..self.scene.objects.len() as u32)
+            .map(|o| samples.iter().find(|s| s.object == o))
+            .collect()
+    }
+
+    /// Direct light reflected by an opaque diffuse surface at `g` towards the camera.
+    pub fn shade_opaque(&self, g: &GSample, light_samples: u32) -> Rgb {
+        let mat = &self.scene.materials[self.scene.objects[g.object as usize].material];
+        let MaterialKind::Diffuse { albedo, texture } = &mat.kind else {
+            return [0.0; 3];
+        };
+        let tex = texture.as_ref().map_or([1.0; 3], |t| t.eval(g.p));
+        // Light the side the camera sees.
+        let (n, ng) = if g.ng.dot(g.wo) >= 0.0 {
+            (g.n, g.ng)
+        } else {
+            (-g.n, -g.ng)
+        };
+        let idx = g.pixel as u64 * self.gbuffer.samples_per_pixel as u64 + g.index as u64;
+        let mut r = rng(self.seed, Stream::Opaque, idx);
+        let mut packets = Vec::new();
+        gather(
+            &self.geom,
+            &self.scene.lights,
+            Receiver { p: g.p, n, ng },
+            light_samples,
+            &mut r,
+            &mut packets,
+        );
+        let mut out = [0.0; 3];
+        for p in &packets {
+            for c in 0..3 {
+                out[c] += albedo[c] * tex[c] / PI * p.e_cos[c];
+            }
+        }
+        out
+    }
+}
+
+fn timed_into<T>(stages: &mut Vec<Stage>, name: &'static str, f: impl FnOnce() -> T) -> T {
+    let t = Instant::now();
+    let v = f();
+    stages.push(Stage {
+        name,
+        seconds: t.elapsed().as_secs_f64(),
+    });
+    v
+}

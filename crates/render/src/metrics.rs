@@ -1,0 +1,181 @@
+//! Image error metrics, in one place for `sss diff`, `cargo xtask compare` and the tests: RMSE,
+//! relative RMSE, the fraction of pixels within a relative error, the mean ratio against a
+//! reference, and the fraction within k standard errors. All are taken over a list of pixel
+//! indices (the pixels with translucent coverage, by convention) and never return NaN.
+
+use sss_bssrdf::Rgb;
+
+/// Error figures of an image against a reference over a set of pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorFigures {
+    /// Root mean square error over pixels and channels.
+    pub rmse: f64,
+    /// RMSE divided by the reference's mean over the same pixels and channels.
+    pub rel_rmse: f64,
+    /// Fraction of pixels whose relative error (per-pixel luminance-free: max over channels of
+    /// |a − b| / max(b, floor)) is below `eps`.
+    pub frac_within_eps: f64,
+}
+
+/// Per-pixel relative error: max over channels of |a − b| / max(b, floor), where `floor` is 1 %
+/// of the reference's mean (so nearly black pixels do not dominate).
+pub fn relative_errors(image: &[Rgb], reference: &[Rgb], pixels: &[usize]) -> Vec<f64> {
+    let mean = reference_mean(reference, pixels);
+    let floor = (mean * 0.01).max(1e-300);
+    pixels
+        .iter()
+        .map(|&i| {
+            (0..3)
+                .map(|c| (image[i][c] - reference[i][c]).abs() / reference[i][c].max(floor))
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+fn reference_mean(reference: &[Rgb], pixels: &[usize]) -> f64 {
+    if pixels.is_empty() {
+        return 0.0;
+    }
+    pixels
+        .iter()
+        .map(|&i| reference[i].iter().sum::<f64>() / 3.0)
+        .sum::<f64>()
+        / pixels.len() as f64
+}
+
+/// RMSE, relative RMSE and the fraction of pixels within `eps` relative error, over `pixels`.
+pub fn error_figures(image: &[Rgb], reference: &[Rgb], pixels: &[usize], eps: f64) -> ErrorFigures {
+    if pixels.is_empty() {
+        return ErrorFigures {
+            rmse: 0.0,
+            rel_rmse: 0.0,
+            frac_within_eps: 1.0,
+        };
+    }
+    let mut se = 0.0;
+    for &i in pixels {
+        for c in 0..3 {
+            let d = image[i][c] - reference[i][c];
+            se += d * d;
+        }
+    }
+    let rmse = (se / (3 * pixels.len()) as f64).sqrt();
+    let mean = reference_mean(reference, pixels);
+    let rel = relative_errors(image, reference, pixels);
+    let within = rel.iter().filter(|e| **e < eps).count();
+    ErrorFigures {
+        rmse,
+        rel_rmse: if mean > 0.0 { rmse / mean } else { 0.0 },
+        frac_within_eps: within as f64 / pixels.len() as f64,
+    }
+}
+
+/// Ratio of the image's mean to the reference's over `pixels`, per channel (0 where the
+/// reference's mean is 0).
+pub fn mean_ratio_rgb(image: &[Rgb], reference: &[Rgb], pixels: &[usize]) -> Rgb {
+    let mean = |img: &[Rgb]| -> Rgb {
+        let mut m = [0.0; 3];
+        for &i in pixels {
+            for c in 0..3 {
+                m[c] += img[i][c] / pixels.len().max(1) as f64;
+            }
+        }
+        m
+    };
+    let (ma, mb) = (mean(image), mean(reference));
+    [0, 1, 2].map(|c| if mb[c] > 0.0 { ma[c] / mb[c] } else { 0.0 })
+}
+
+/// Ratio of the image's sum to the reference's over `pixels` and all channels (0 when the
+/// reference sums to 0): 1 for an unbiased method, up to noise.
+pub fn mean_ratio(image: &[Rgb], reference: &[Rgb], pixels: &[usize]) -> f64 {
+    let sum = |img: &[Rgb]| -> f64 { pixels.iter().map(|&i| img[i].iter().sum::<f64>()).sum() };
+    let r = sum(reference);
+    if r > 0.0 { sum(image) / r } else { 0.0 }
+}
+
+/// Fraction of `pixels` whose every channel lies within `k` standard errors `se` of the
+/// reference (plus 1e-12 relative, so exact agreement with a zero error bar counts); `None`
+/// for no pixels.
+pub fn frac_within_se(
+    image: &[Rgb],
+    se: &[Rgb],
+    reference: &[Rgb],
+    pixels: &[usize],
+    k: f64,
+) -> Option<f64> {
+    if pixels.is_empty() {
+        return None;
+    }
+    let ok = pixels
+        .iter()
+        .filter(|&&i| {
+            (0..3).all(|c| {
+                let d = (image[i][c] - reference[i][c]).abs();
+                d <= k * se[i][c] + 1e-12 * reference[i][c].abs()
+            })
+        })
+        .count();
+    Some(ok as f64 / pixels.len() as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn img(v: &[f64]) -> Vec<Rgb> {
+        v.iter().map(|&x| [x, 2.0 * x, 3.0 * x]).collect()
+    }
+
+    /// A uniformly scaled image: every figure has a closed form.
+    #[test]
+    fn scaled_image_figures_are_closed_forms() {
+        let reference = img(&[1.0, 2.0, 4.0, 0.0]);
+        let image: Vec<Rgb> = reference.iter().map(|p| p.map(|v| 1.1 * v)).collect();
+        let pixels = [0, 1, 2];
+        let f = error_figures(&image, &reference, &pixels, 0.05);
+        // Differences are 0.1·v; squares of (1,2,3)·(1,2,4) summed: (1+4+9)(1+4+16) = 294.
+        let rmse = (0.01 * 294.0 / 9.0f64).sqrt();
+        assert!((f.rmse - rmse).abs() < 1e-14 * rmse, "{}", f.rmse);
+        // Reference mean over pixels and channels: (1+2+3)(1+2+4)/9 = 42/9.
+        assert!((f.rel_rmse - rmse / (42.0 / 9.0)).abs() < 1e-14);
+        assert_eq!(f.frac_within_eps, 0.0, "10 % is outside 5 %");
+        let g = error_figures(&image, &reference, &pixels, 0.11);
+        assert_eq!(g.frac_within_eps, 1.0);
+        assert!((mean_ratio(&image, &reference, &pixels) - 1.1).abs() < 1e-14);
+        for r in mean_ratio_rgb(&image, &reference, &pixels) {
+            assert!((r - 1.1).abs() < 1e-14);
+        }
+    }
+
+    /// Relative errors use a floor of 1 % of the reference mean for dark pixels.
+    #[test]
+    fn relative_error_floor_and_empty_sets() {
+        let reference = img(&[100.0, 0.0]);
+        let image = img(&[100.0, 1.0]);
+        let rel = relative_errors(&image, &reference, &[0, 1]);
+        assert_eq!(rel[0], 0.0);
+        // Mean over both pixels and channels: 100·6/6 = 100, floor 1; blue differs by 3.
+        assert!((rel[1] - 3.0).abs() < 1e-12, "{}", rel[1]);
+        let e = error_figures(&image, &reference, &[], 0.05);
+        assert_eq!((e.rmse, e.rel_rmse, e.frac_within_eps), (0.0, 0.0, 1.0));
+        assert_eq!(mean_ratio(&image, &[[0.0; 3]; 2], &[0, 1]), 0.0);
+        assert_eq!(frac_within_se(&image, &image, &reference, &[], 3.0), None);
+    }
+
+    #[test]
+    fn within_k_standard_errors() {
+        let reference = img(&[1.0, 1.0]);
+        let image = vec![[1.2, 2.0, 3.0], [1.0, 2.0, 3.0]];
+        let se = vec![[0.1; 3], [0.0; 3]];
+        // Pixel 0 is 2 SE off in red; pixel 1 agrees exactly with a zero error bar.
+        assert_eq!(
+            frac_within_se(&image, &se, &reference, &[0, 1], 3.0),
+            Some(1.0)
+        );
+        assert_eq!(
+            frac_within_se(&image, &se, &reference, &[0, 1], 1.5),
+            Some(0.5)
+        );
+    }
+}

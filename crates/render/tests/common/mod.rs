@@ -1,0 +1,3 @@
+//! Helpers shared by the render crate's integration tests.
+
+pub mod rasterizer;

@@ -1,0 +1,161 @@
+//! The `[materials.NAME]` tables: translucent materials (a model, and a preset or explicit
+//! coefficients) and diffuse ones.
+
+use super::context::{Ctx, fmt_num, list};
+use crate::format::{Keys, MaterialDef, Triple};
+use crate::{MaterialKind, SceneError, Translucent};
+use sss_bssrdf::presets::{PRESET_ETA, PRESETS};
+use sss_bssrdf::{Medium, ModelKind, Rgb};
+use std::str::FromStr;
+
+impl Ctx<'_> {
+    pub(super) fn material(&self, m: &MaterialDef, path: &str) -> Result<MaterialKind, SceneError> {
+        let present = m.present();
+        let key = |k: &str| format!("{path}.{k}");
+        match m.kind.as_str() {
+            "translucent" => {
+                let what = "a translucent material";
+                self.check_keys(
+                    path,
+                    &present,
+                    &[
+                        "model",
+                        "preset",
+                        "sigma_a",
+                        "sigma_s",
+                        "g",
+                        "eta",
+                        "units_per_mm",
+                        "texture",
+                    ],
+                    what,
+                )?;
+                let model = match &m.model {
+                    None => ModelKind::BetterDipole,
+                    Some(name) => ModelKind::from_str(name).map_err(|_| {
+                        let names: Vec<&str> = ModelKind::ALL.iter().map(|k| k.name()).collect();
+                        self.err(
+                            &key("model"),
+                            format!("unknown model `{name}`; expected one of {}", list(&names)),
+                        )
+                    })?,
+                };
+                let g = m.g.unwrap_or(0.0);
+                if !(g.is_finite() && g.abs() < 1.0) {
+                    return Err(self.err(
+                        &key("g"),
+                        format!("the anisotropy must be in (-1, 1), got {}", fmt_num(g)),
+                    ));
+                }
+                let eta = m.eta.unwrap_or(PRESET_ETA);
+                if !(eta.is_finite() && eta > 0.0) {
+                    return Err(self.err(
+                        &key("eta"),
+                        format!(
+                            "the relative index of refraction must be finite and > 0, got {}",
+                            fmt_num(eta)
+                        ),
+                    ));
+                }
+                let (sigma_a, sigma_s) = match (&m.preset, m.sigma_a, m.sigma_s) {
+                    (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+                        let k = if m.sigma_a.is_some() {
+                            "sigma_a"
+                        } else {
+                            "sigma_s"
+                        };
+                        return Err(self.err(
+                            &key(k),
+                            "give either `preset` or `sigma_a` and `sigma_s`, not both",
+                        ));
+                    }
+                    (Some(name), None, None) => {
+                        let p = sss_bssrdf::presets::find(name).map_err(|_| {
+                            let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
+                            self.err(
+                                &key("preset"),
+                                format!(
+                                    "unknown preset `{name}`; expected one of {}",
+                                    list(&names)
+                                ),
+                            )
+                        })?;
+                        // The table gives reduced scattering; keep it under the chosen g.
+                        (p.sigma_a, p.sigma_s_reduced.map(|s| s / (1.0 - g)))
+                    }
+                    (None, a, s) => {
+                        let a = a.ok_or_else(|| {
+                            self.err(
+                                &key("sigma_a"),
+                                "a translucent material needs `preset` or `sigma_a` and `sigma_s`",
+                            )
+                        })?;
+                        let s = s.ok_or_else(|| {
+                            self.err(
+                                &key("sigma_s"),
+                                "a translucent material needs `preset` or `sigma_a` and `sigma_s`",
+                            )
+                        })?;
+                        (
+                            self.coefficient(a, &key("sigma_a"))?,
+                            self.coefficient(s, &key("sigma_s"))?,
+                        )
+                    }
+                };
+                let medium = Medium::new(sigma_a, sigma_s, g, eta)
+                    .map_err(|e| self.err(path, format!("invalid medium: {e}")))?;
+                let upm = self.required(m.units_per_mm, path, "units_per_mm", what)?;
+                if !(upm.is_finite() && upm > 0.0) {
+                    return Err(self.err(
+                        &key("units_per_mm"),
+                        format!(
+                            "scene units per millimetre must be finite and > 0, got {}",
+                            fmt_num(upm)
+                        ),
+                    ));
+                }
+                let texture = match &m.texture {
+                    Some(t) => Some(self.texture(t, &key("texture"))?),
+                    None => None,
+                };
+                Ok(MaterialKind::Translucent(Translucent {
+                    model,
+                    medium,
+                    units_per_mm: upm,
+                    texture,
+                }))
+            }
+            "diffuse" => {
+                let what = "a diffuse material";
+                self.check_keys(path, &present, &["albedo", "texture"], what)?;
+                let albedo = self.required(m.albedo, path, "albedo", what)?;
+                let albedo = self.unit_colour(albedo, &key("albedo"))?;
+                let texture = match &m.texture {
+                    Some(t) => Some(self.texture(t, &key("texture"))?),
+                    None => None,
+                };
+                Ok(MaterialKind::Diffuse { albedo, texture })
+            }
+            other => Err(self.err(
+                &key("type"),
+                format!("unknown material type `{other}`; expected `translucent` or `diffuse`"),
+            )),
+        }
+    }
+
+    /// A coefficient in 1/mm: finite and ≥ 0 per channel.
+    pub(super) fn coefficient(&self, c: Triple, key: &str) -> Result<Rgb, SceneError> {
+        for (ch, v) in c.0.iter().enumerate() {
+            if !v.is_finite() || *v < 0.0 {
+                return Err(self.err(
+                    key,
+                    format!(
+                        "coefficients must be finite and non-negative (1/mm), got {} in channel {ch}",
+                        fmt_num(*v)
+                    ),
+                ));
+            }
+        }
+        Ok(c.0)
+    }
+}
