@@ -1,7 +1,7 @@
 //! Options shared by several subcommands: the medium (`--preset` or coefficients) and
 //! `R,G,B` triples.
 
-use crate::profile_table::MediumSpec;
+use crate::medium_spec::MediumSpec;
 use clap::{ArgGroup, Args};
 use sss_bssrdf::Rgb;
 use sss_render::Error;

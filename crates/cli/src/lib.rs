@@ -23,6 +23,7 @@
 
 pub mod args;
 pub mod commands;
+pub mod medium_spec;
 pub mod method_flags;
 pub mod presets_table;
 pub mod profile_table;

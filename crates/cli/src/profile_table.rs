@@ -19,8 +19,10 @@
 //! ```
 
 use crate::Error;
+use crate::medium_spec::medium_label;
+pub use crate::medium_spec::{MediumSpec, build_medium};
 use sss_bssrdf::monte_carlo::{self, McConfig};
-use sss_bssrdf::{Medium, ModelKind, Rgb, make_model, presets};
+use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_plot::{CHANNEL_COLORS, ErrorStyle, PlotError, Series, line_plot};
 use std::io::Write;
 use std::path::Path;
@@ -62,22 +64,6 @@ impl ProfileModel {
             None => "monte-carlo",
         }
     }
-}
-
-/// Where the medium comes from.
-#[derive(Clone, Debug, PartialEq)]
-pub enum MediumSpec {
-    /// A measured material of Jensen et al. 2001 by name (g = 0, σ_s = σ'_s).
-    Preset(String),
-    /// Explicit coefficients (1/mm) and anisotropy.
-    Coefficients {
-        /// Absorption σ_a per channel.
-        sigma_a: Rgb,
-        /// Scattering σ_s per channel.
-        sigma_s: Rgb,
-        /// Henyey-Greenstein anisotropy.
-        g: f64,
-    },
 }
 
 /// Everything `sss profile` needs.
@@ -141,20 +127,6 @@ pub struct ProfileTable {
     pub rows: Vec<ProfileRow>,
 }
 
-/// Builds the medium of `spec`, with `eta` if given (default [`presets::PRESET_ETA`]).
-pub fn build_medium(spec: &MediumSpec, eta: Option<f64>) -> Result<Medium, Error> {
-    let eta = eta.unwrap_or(presets::PRESET_ETA);
-    let medium = match spec {
-        MediumSpec::Preset(name) => Medium::preset(name)?.with_eta(eta)?,
-        MediumSpec::Coefficients {
-            sigma_a,
-            sigma_s,
-            g,
-        } => Medium::new(*sigma_a, *sigma_s, *g, eta)?,
-    };
-    Ok(medium)
-}
-
 /// The radii of a model profile: `steps` values r_max/N, 2r_max/N, …, r_max, or with `log`
 /// log-spaced from r_max·1e-4 to r_max (a single step gives r_max).
 pub fn radii(r_max: f64, steps: usize, log: bool) -> Vec<f64> {
@@ -214,22 +186,6 @@ fn check_request(req: &ProfileRequest) -> Result<(), Error> {
         }
     }
     Ok(())
-}
-
-fn medium_label(spec: &MediumSpec, medium: &Medium) -> String {
-    match spec {
-        MediumSpec::Preset(name) => format!("{name}, eta {}", medium.eta()),
-        MediumSpec::Coefficients {
-            sigma_a,
-            sigma_s,
-            g,
-        } => format!(
-            "sigma_a {:?}, sigma_s {:?}, g {g}, eta {}",
-            sigma_a,
-            sigma_s,
-            medium.eta()
-        ),
-    }
 }
 
 fn finite(what: &str, v: f64) -> Result<f64, Error> {

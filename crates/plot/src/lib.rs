@@ -214,10 +214,10 @@ const PANEL_SIZE: (u32, u32) = (800, 560);
 /// Draws one chart of `series` to `path` (`.png` or `.svg`).
 ///
 /// ```no_run
-/// use sss_render::plot::{line_plot, Series};
+/// use sss_plot::{line_plot, Series};
 /// let s = Series::line("exp", (1..100).map(|i| (i as f64, (-(i as f64) / 10.0).exp())).collect());
 /// line_plot("out.svg".as_ref(), "decay", "r (mm)", "Rd (1/mm²)", &[s], false, true)?;
-/// # Ok::<(), sss_render::plot::PlotError>(())
+/// # Ok::<(), sss_plot::PlotError>(())
 /// ```
 pub fn line_plot(
     path: &Path,

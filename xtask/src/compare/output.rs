@@ -4,18 +4,10 @@ use super::Error;
 use std::path::Path;
 
 /// Writes `bytes` to a temporary file next to `path` and renames it into place, so a reader
-/// never sees a half-written file.
+/// never sees a half-written file (`sss_util::write_atomic`).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        Error(format!("cannot write '{}': {e}", path.display()))
-    })
+    sss_util::write_atomic(path, bytes)
+        .map_err(|e| Error(format!("cannot write '{}': {e}", path.display())))
 }
 
 /// A number for the CSV: shortest round-trip notation; empty for a missing or non-finite
