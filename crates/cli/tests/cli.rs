@@ -947,3 +947,43 @@ fn filter_reads_the_gbuffer_and_reproduces_the_pass() {
     ]);
     assert!(stderr(&o).contains("--units-per-mm"), "{}", stderr(&o));
 }
+
+/// A binding cap and a flag of another method are reported on stderr as `warning:` lines;
+/// the render still succeeds.
+#[test]
+fn render_warns_when_a_cap_binds_and_for_foreign_flags() {
+    let dir = tmp_dir("render-warnings");
+    let scene = dir.join("ball.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\nposition = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
+         fov = 30.0\nresolution = [16, 12]\n\n[[lights]]\ntype = \"directional\"\n\
+         direction = [0.0, 0.0, -1.0]\nirradiance = 1.0\n\n[materials.wax]\n\
+         type = \"translucent\"\nmodel = \"better-dipole\"\npreset = \"skin1\"\n\
+         units_per_mm = 0.1\n\n[[objects]]\nname = \"ball\"\nmaterial = \"wax\"\n\
+         shape = \"sphere\"\nradius = 1.0\n",
+    )
+    .unwrap();
+    let path = scene.to_str().unwrap();
+    let o = sss(&["render", path, "--max-samples", "300", "--spp", "4"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("warning: ")).collect();
+    assert_eq!(lines.len(), 2, "{err}");
+    assert!(
+        lines[0].contains("--spp") && lines[0].contains("exact"),
+        "{err}"
+    );
+    assert!(
+        lines[1].contains("cap of 300") && lines[1].contains("--max-samples"),
+        "{err}"
+    );
+    assert!(
+        stdout(&o).contains("irradiance samples: "),
+        "{}",
+        stdout(&o)
+    );
+    let o = sss(&["render", path]);
+    assert!(o.status.success());
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+}

@@ -47,6 +47,7 @@ pub struct Frame<'a> {
     pub shading: Vec<Option<TranslucentShading>>,
     stages: Mutex<Vec<Stage>>,
     samples: Mutex<Option<CachedSamples>>,
+    warnings: Mutex<Vec<String>>,
 }
 
 impl<'a> Frame<'a> {
@@ -64,6 +65,10 @@ impl<'a> Frame<'a> {
             .filter(|&o| seen[o as usize] && scene.translucent(o as usize).is_some())
             .collect();
         let shading = timed_into(&mut stages, "models", || shading_for(scene, &visible));
+        let warnings = visible
+            .iter()
+            .filter_map(|&o| implausible_size(scene, o))
+            .collect();
         Frame {
             scene,
             seed,
@@ -73,6 +78,7 @@ impl<'a> Frame<'a> {
             shading,
             stages: Mutex::new(stages),
             samples: Mutex::new(None),
+            warnings: Mutex::new(warnings),
         }
     }
 }
@@ -92,6 +98,23 @@ impl Frame<'_> {
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
             .push(Stage { name, seconds });
+    }
+
+    /// Records a warning for the caller (a cap that bound, implausible units, ...): one line
+    /// for a person, saying what was requested, what was used and how to change it.
+    pub fn warn(&self, message: String) {
+        let mut w = self.warnings.lock().unwrap_or_else(PoisonError::into_inner);
+        if !w.contains(&message) {
+            w.push(message);
+        }
+    }
+
+    /// The warnings recorded so far, in order.
+    pub fn warnings(&self) -> Vec<String> {
+        self.warnings
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
     }
 
     /// The stages recorded so far, in order.
@@ -120,6 +143,9 @@ impl Frame<'_> {
         let samples = Arc::new(self.timed("samples", || {
             irradiance::compute(self.scene, &self.geom, &self.visible, settings, self.seed)
         }));
+        for s in samples.iter().filter(|s| s.capped()) {
+            self.warn(cap_warning(self.scene, s, settings));
+        }
         *cache = Some(CachedSamples {
             settings: *settings,
             samples: Arc::clone(&samples),
@@ -182,6 +208,71 @@ impl Frame<'_> {
         }
         out
     }
+}
+
+/// The warning for an object whose irradiance samples the per-object cap made coarser than
+/// requested: requested and effective spacing in mean free paths, and how to lift the cap.
+fn cap_warning(scene: &Scene, s: &ObjectSamples, settings: &IrradianceSettings) -> String {
+    let object = &scene.objects[s.object as usize];
+    let material = &scene.materials[object.material].name;
+    let used_mfp = s.spacing / s.mfp.max(1e-300);
+    // The count grows as 1/spacing² on a surface.
+    let ratio = (s.spacing / s.requested_spacing.max(1e-300)).powi(2);
+    let needed = (s.samples.len() as f64 * ratio).ceil();
+    let needed = if needed < 1e9 {
+        format!("{needed:.0}")
+    } else {
+        format!("{needed:.1e}")
+    };
+    format!(
+        "object `{}` (material `{material}`): the cap of {} irradiance samples per object bound, \
+        so samples are {used_mfp:.3} mean free paths apart instead of the requested {}; raise \
+        --max-samples to about {needed} (or check the material's units_per_mm) to lift it",
+        object.name, settings.max_samples, settings.spacing_mfp
+    )
+}
+
+/// Objects this many reduced mean free paths across or more are implausibly large.
+pub const MAX_PLAUSIBLE_MFP: f64 = 1e4;
+
+/// A warning when translucent object `o` is smaller than one reduced mean free path across or
+/// larger than [`MAX_PLAUSIBLE_MFP`] of them: almost always a `units_per_mm` mistake (the
+/// model then sees a speck of translucent material, or an opaque wall).
+fn implausible_size(scene: &Scene, o: u32) -> Option<String> {
+    let t = scene.translucent(o as usize)?;
+    let object = &scene.objects[o as usize];
+    let mesh = &object.mesh;
+    let (mut lo, mut hi) = (
+        glam::DVec3::splat(f64::INFINITY),
+        glam::DVec3::splat(f64::NEG_INFINITY),
+    );
+    for p in &mesh.positions {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let size = (hi - lo).max_element();
+    if !(size.is_finite() && size > 0.0 && t.units_per_mm > 0.0) {
+        return None;
+    }
+    // Reduced mean free paths over the channels: the scales the light spreads on.
+    let mfp = |c: usize| 1.0 / t.medium.sigma_t_reduced(c).max(1e-300);
+    let mfp_min = (0..3).map(mfp).fold(f64::INFINITY, f64::min);
+    let mfp_max = (0..3).map(mfp).fold(0.0, f64::max);
+    let size_mm = size / t.units_per_mm;
+    let material = &scene.materials[object.material].name;
+    // Smaller than the shortest one in every channel, or larger than 10⁴ of the longest.
+    let (across, what) = if size_mm < mfp_min {
+        (size_mm / mfp_min, "smaller than one")
+    } else if size_mm > MAX_PLAUSIBLE_MFP * mfp_max {
+        (size_mm / mfp_max, "larger than 10⁴")
+    } else {
+        return None;
+    };
+    Some(format!(
+        "object `{}` (material `{material}`) is {across:.3e} reduced mean free paths across, \
+        {what}: with units_per_mm = {} it measures {size_mm:.3e} mm; check units_per_mm",
+        object.name, t.units_per_mm
+    ))
 }
 
 fn timed_into<T>(stages: &mut Vec<Stage>, name: &'static str, f: impl FnOnce() -> T) -> T {

@@ -59,6 +59,11 @@ pub struct ObjectSamples {
     pub object: u32,
     /// Minimum spacing actually used (scene units).
     pub spacing: f64,
+    /// Minimum spacing requested (scene units): `spacing_mfp` × the smallest reduced mean free
+    /// path. Larger `spacing` means the per-object cap bound.
+    pub requested_spacing: f64,
+    /// The smallest reduced mean free path of the object's material (scene units).
+    pub mfp: f64,
     /// The samples.
     pub samples: Vec<IrradianceSample>,
     /// Directional-dipole objects only: every sample's incident light packets (texture
@@ -70,6 +75,11 @@ pub struct ObjectSamples {
 }
 
 impl ObjectSamples {
+    /// Whether the per-object cap (`max_samples`) made the samples coarser than requested.
+    pub fn capped(&self) -> bool {
+        self.spacing > self.requested_spacing * (1.0 + 1e-9)
+    }
+
     /// The incident light packets of sample `i` (empty unless the model needs directions).
     pub fn incident_of(&self, i: usize) -> &[Incident] {
         if self.incident_offsets.is_empty() {
@@ -165,6 +175,8 @@ pub fn compute(
             Some(ObjectSamples {
                 object: o,
                 spacing: stats.radius,
+                requested_spacing: spacing,
+                mfp: mfp_mm * mat.units_per_mm,
                 samples,
                 incident,
                 incident_offsets,

@@ -59,6 +59,9 @@ pub struct RenderOutput {
     pub spacing: Vec<(u32, f64)>,
     /// Extra per-pixel layers of the method (e.g. the separable pass's screen-space inputs).
     pub layers: Vec<Layer>,
+    /// Warnings for the user: caps that bound (with the requested and effective value and how
+    /// to lift them), implausible units. Empty when nothing needs saying.
+    pub warnings: Vec<String>,
 }
 
 impl RenderOutput {
@@ -117,6 +120,7 @@ pub fn render(
         irradiance_samples,
         spacing,
         layers: shaded.layers,
+        warnings: frame.warnings(),
     })
 }
 

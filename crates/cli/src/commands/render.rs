@@ -151,6 +151,9 @@ pub fn run(args: &RenderArgs) -> Result<String, Error> {
     let out = pool.install(|| render(&scene, method.as_ref(), &settings, &bar));
     bar.0.finish_and_clear();
     let out = out?;
+    for w in &out.warnings {
+        eprintln!("warning: {w}");
+    }
     let write_t = std::time::Instant::now();
     if let Some(p) = &args.out {
         let mut layers: Vec<(&str, &[Rgb])> =

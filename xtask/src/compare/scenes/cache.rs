@@ -103,6 +103,9 @@ pub(in super::super) fn reference(
     };
     let out = render(scene, &reference_method(cfg.quick), &settings, &NoProgress)
         .map_err(|e| Error(format!("scene {}: reference: {e}", scene.name)))?;
+    for w in &out.warnings {
+        (ctx.log)(&format!("scene {}: reference: warning: {w}", scene.name));
+    }
     let cov: Vec<Rgb> = out.coverage.iter().map(|&c| [c as f64; 3]).collect();
     write_exr(
         &path,

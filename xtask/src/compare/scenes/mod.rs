@@ -95,6 +95,9 @@ impl Experiment for SceneComparison {
                         let method = (m.build)(&MethodOptions::new().with(m.sweep.option, v))
                             .map_err(|e| Error(format!("{label}: {e}")))?;
                         let out = run_timed(method.as_ref(), scene, &settings, threads, &label)?;
+                        for w in &out.warnings {
+                            (ctx.log)(&format!("scene {}: {label}: warning: {w}", scene.name));
+                        }
                         let f = error_figures(&out.subsurface, &reference.subsurface, &pixels, EPS);
                         let run = Run {
                             scene: scene.name.clone(),
@@ -116,6 +119,7 @@ impl Experiment for SceneComparison {
                                 )
                             }),
                             mean_ratio: mean_ratio(&out.subsurface, &reference.subsurface, &pixels),
+                            warnings: out.warnings.clone(),
                         };
                         if threads == all_threads {
                             points.push((run.seconds_total(), run.rmse));
@@ -174,7 +178,12 @@ impl Experiment for SceneComparison {
                 .map(|r| {
                     vec![
                         r.method.to_string(),
-                        format!("{}={}", r.param, r.value),
+                        // A run whose caps bound (or whose units look wrong) is marked.
+                        if r.warnings.is_empty() {
+                            format!("{}={}", r.param, r.value)
+                        } else {
+                            format!("{}={} ⚠", r.param, r.value)
+                        },
                         r.threads.to_string(),
                         md_num(Some(r.seconds_total()), 3),
                         md_num(r.stage("shading"), 3),
@@ -232,6 +241,25 @@ impl Experiment for SceneComparison {
         );
         for s in &skipped {
             let _ = writeln!(summary, "\nSkipped {s}");
+        }
+        let mut warned: Vec<String> = Vec::new();
+        for r in runs.iter().filter(|r| !r.warnings.is_empty()) {
+            for w in &r.warnings {
+                let line = format!("`{}` {} {}={}: {w}", r.scene, r.method, r.param, r.value);
+                if !warned.contains(&line) {
+                    warned.push(line);
+                }
+            }
+        }
+        if !warned.is_empty() {
+            let _ = writeln!(
+                summary,
+                "\nRuns marked ⚠ gave warnings (a cap bound, or implausible units; count in the \
+                 `warnings` column of `results.csv`):\n"
+            );
+            for w in &warned {
+                let _ = writeln!(summary, "- {w}");
+            }
         }
         let _ = writeln!(
             summary,

@@ -47,6 +47,8 @@ pub struct Run {
     /// Mean over translucent pixels and channels of the render divided by the reference's
     /// (1 for an unbiased method, up to noise).
     pub mean_ratio: f64,
+    /// Warnings the render gave (a cap that bound, implausible units).
+    pub warnings: Vec<String>,
 }
 
 impl Run {
@@ -72,7 +74,7 @@ pub fn csv_header(stages: &[&str]) -> String {
     for s in stages {
         let _ = write!(h, ",seconds_{s}");
     }
-    h.push_str(",rmse,rel_rmse,frac_within_eps,frac_within_3se,mean_ratio\n");
+    h.push_str(",rmse,rel_rmse,frac_within_eps,frac_within_3se,mean_ratio,warnings\n");
     h
 }
 
@@ -95,12 +97,13 @@ pub fn csv_rows(runs: &[Run]) -> String {
         }
         let _ = writeln!(
             s,
-            ",{},{},{},{},{}",
+            ",{},{},{},{},{},{}",
             csv_num(Some(r.rmse)),
             csv_num(Some(r.rel_rmse)),
             csv_num(Some(r.frac_within_eps)),
             csv_num(r.within_3se),
-            csv_num(Some(r.mean_ratio))
+            csv_num(Some(r.mean_ratio)),
+            r.warnings.len()
         );
     }
     s
@@ -143,6 +146,7 @@ mod tests {
             frac_within_eps: 1.0,
             within_3se: None,
             mean_ratio: 1.0,
+            warnings: Vec::new(),
         }
     }
 
@@ -207,6 +211,7 @@ mod tests {
             "rmse",
             "rel_rmse",
             "frac_within_eps",
+            "warnings",
         ] {
             assert!(
                 h.split(',').any(|c| c.trim() == col),

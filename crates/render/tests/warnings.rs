@@ -1,0 +1,160 @@
+//! Caps that bind and implausible units are reported as warnings in the render output (the
+//! CLI prints them as `warning:` lines, `compare` marks the runs), with the requested and the
+//! effective value and how to lift the cap.
+
+use sss_render::integrators::exact::Exact;
+use sss_render::irradiance::IrradianceSettings;
+use sss_render::progress::NoProgress;
+use sss_render::render::{RenderSettings, render};
+use sss_render::scene::{LoadOptions, builtin, load_str};
+
+fn sphere_scene(units_per_mm: f64) -> sss_render::scene::Scene {
+    let text = format!(
+        r#"
+[camera]
+position = [0.0, 0.0, 5.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 30.0
+resolution = [24, 18]
+
+[[lights]]
+type = "directional"
+direction = [0.0, 0.0, -1.0]
+irradiance = 1.0
+
+[materials.wax]
+type = "translucent"
+model = "better-dipole"
+preset = "skin1"
+units_per_mm = {units_per_mm}
+
+[[objects]]
+name = "ball"
+material = "wax"
+shape = "sphere"
+radius = 1.0
+"#
+    );
+    load_str(&text, "ball.toml", None, &LoadOptions::default()).unwrap()
+}
+
+/// skin1's reduced extinction per channel (1/mm), from Jensen et al. 2001 Table 2
+/// (σ'_s = 0.74, 0.88, 1.01; σ_a = 0.032, 0.17, 0.48).
+const SIGMA_T_REDUCED: [f64; 3] = [0.74 + 0.032, 0.88 + 0.17, 1.01 + 0.48];
+
+#[test]
+fn a_binding_sample_cap_warns_with_requested_and_effective_spacing() {
+    let scene = sphere_scene(0.1);
+    let exact = Exact {
+        irradiance: IrradianceSettings {
+            spacing_mfp: 0.25,
+            max_samples: 500,
+            ..IrradianceSettings::default()
+        },
+    };
+    let out = render(&scene, &exact, &RenderSettings::default(), &NoProgress).unwrap();
+    assert_eq!(out.warnings.len(), 1, "{:?}", out.warnings);
+    let w = &out.warnings[0];
+    assert!(w.contains("`ball`") && w.contains("`wax`"), "{w}");
+    assert!(
+        w.contains("cap of 500") && w.contains("requested 0.25"),
+        "{w}"
+    );
+    assert!(w.contains("--max-samples"), "{w}");
+    // The effective spacing in mean free paths, computed here from the spacing reported: the
+    // smallest reduced mean free path is 1/max σ'_t mm = 0.1/1.49 scene units.
+    let (_, spacing) = &out.spacing[0];
+    let mfp = 0.1 / SIGMA_T_REDUCED.iter().cloned().fold(0.0, f64::max);
+    let used = spacing / mfp;
+    assert!(
+        used > 0.25 * 1.5,
+        "the cap must have coarsened the samples: {used}"
+    );
+    assert!(
+        w.contains(&format!("{used:.3} mean free paths apart")),
+        "{w} vs {used}"
+    );
+    // A unit sphere has area 4π; 500 samples spaced `spacing` apart cover about that much, so
+    // lifting the cap needs about 500·(used/0.25)² samples (the message's estimate).
+    let needed = (out.irradiance_samples as f64 * (used / 0.25).powi(2)).ceil();
+    assert!(w.contains(&format!("about {needed:.0}")), "{w} vs {needed}");
+}
+
+#[test]
+fn no_warning_when_nothing_binds() {
+    let scene = sphere_scene(0.1);
+    let out = render(
+        &scene,
+        &Exact::default(),
+        &RenderSettings::default(),
+        &NoProgress,
+    )
+    .unwrap();
+    assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+    for name in ["sphere", "toad", "slab", "backlit"] {
+        let mut s = builtin(name, &LoadOptions::default()).unwrap();
+        s.camera.width /= 8;
+        s.camera.height /= 8;
+        let coarse = Exact {
+            irradiance: IrradianceSettings {
+                spacing_mfp: 2.0,
+                ..IrradianceSettings::default()
+            },
+        };
+        let out = render(&s, &coarse, &RenderSettings::default(), &NoProgress).unwrap();
+        assert!(out.warnings.is_empty(), "{name}: {:?}", out.warnings);
+    }
+}
+
+#[test]
+fn implausible_units_warn_naming_object_material_and_units() {
+    // 2 scene units across at 1e-7 units per mm: 2e7 mm, far over 10⁴ mean free paths.
+    let huge = sphere_scene(1e-7);
+    let exact = Exact {
+        irradiance: IrradianceSettings {
+            max_samples: 200,
+            ..IrradianceSettings::default()
+        },
+    };
+    let out = render(&huge, &exact, &RenderSettings::default(), &NoProgress).unwrap();
+    let units: Vec<&String> = out
+        .warnings
+        .iter()
+        .filter(|w| w.contains("check units_per_mm"))
+        .collect();
+    assert_eq!(units.len(), 1, "{:?}", out.warnings);
+    let w = units[0];
+    assert!(w.contains("`ball`") && w.contains("`wax`"), "{w}");
+    assert!(w.contains("units_per_mm = 0.0000001"), "{w}");
+    assert!(w.contains("larger than 10⁴"), "{w}");
+    // The cap binds too and says so.
+    assert!(
+        out.warnings.iter().any(|w| w.contains("cap of 200")),
+        "{:?}",
+        out.warnings
+    );
+
+    // 2 scene units at 1e4 units per mm: 0.2 µm, under one mean free path (≥ 0.67 mm).
+    let tiny = sphere_scene(1e4);
+    let out = render(&tiny, &exact, &RenderSettings::default(), &NoProgress).unwrap();
+    assert!(
+        out.warnings
+            .iter()
+            .any(|w| w.contains("smaller than one") && w.contains("units_per_mm = 10000")),
+        "{:?}",
+        out.warnings
+    );
+
+    // Just inside both bounds: 2 scene units at 1 unit per mm is 2 mm, between 1 and 10⁴
+    // mean free paths in every channel.
+    let fine = sphere_scene(1.0);
+    let out = render(&fine, &exact, &RenderSettings::default(), &NoProgress).unwrap();
+    assert!(
+        !out.warnings
+            .iter()
+            .any(|w| w.contains("check units_per_mm")),
+        "{:?}",
+        out.warnings
+    );
+}
