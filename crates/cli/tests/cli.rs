@@ -986,4 +986,28 @@ fn render_warns_when_a_cap_binds_and_for_foreign_flags() {
     let o = sss(&["render", path]);
     assert!(o.status.success());
     assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+
+    // Over the memory budget: one error line, exit 2, no output file.
+    let out = dir.join("x.exr");
+    let o = sss(&[
+        "render",
+        path,
+        "--max-memory",
+        "1K",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("--max-memory"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 1, "only the scene file: {names:?}");
 }

@@ -52,7 +52,9 @@ pub struct Frame<'a> {
 
 impl<'a> Frame<'a> {
     /// Builds the BVHs, casts the camera rays and builds the models of the translucent
-    /// materials the camera sees.
+    /// materials the camera sees. It allocates for every camera sample: check the frame
+    /// against a memory budget first ([`crate::budget::check_frame`], which
+    /// [`crate::render::render`] does).
     pub fn prepare(scene: &'a Scene, seed: u64) -> Frame<'a> {
         let mut stages = Vec::new();
         let geom = timed_into(&mut stages, "bvh", || SceneGeometry::new(scene));

@@ -63,6 +63,7 @@
 // Colour loops index several [f64; 3] arrays in step (`for c in 0..3`).
 #![allow(clippy::needless_range_loop)]
 
+pub mod budget;
 pub mod camera;
 mod error;
 pub mod frame;

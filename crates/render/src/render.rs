@@ -19,6 +19,9 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Light samples per quad or environment light when shading opaque surfaces.
     pub opaque_light_samples: u32,
+    /// Memory budget in bytes: a frame estimated to need more is refused before anything is
+    /// allocated ([`crate::budget::check_frame`]). Default: half the physical memory.
+    pub max_memory: u64,
 }
 
 impl Default for RenderSettings {
@@ -26,6 +29,7 @@ impl Default for RenderSettings {
         RenderSettings {
             seed: 1,
             opaque_light_samples: 16,
+            max_memory: crate::budget::default_budget(),
         }
     }
 }
@@ -86,14 +90,16 @@ impl RenderOutput {
     }
 }
 
-/// Renders `scene` with `integrator`. `progress` counts shaded G-buffer samples. Fails when
-/// the integrator does (e.g. a kernel cannot be built, or a method needs a radial model).
+/// Renders `scene` with `integrator`. `progress` counts shaded G-buffer samples. Fails before
+/// allocating when the frame would not fit `settings.max_memory`, and when the integrator
+/// fails (e.g. a kernel cannot be built, or a method needs a radial model).
 pub fn render(
     scene: &Scene,
     integrator: &dyn Integrator,
     settings: &RenderSettings,
     progress: &dyn Progress,
 ) -> Result<RenderOutput, crate::Error> {
+    crate::budget::check_frame(scene, settings.max_memory)?;
     let frame = Frame::prepare(scene, settings.seed);
     progress.start(frame.gbuffer.samples.len() as u64);
     let shaded = integrator.integrate(&frame, progress)?;

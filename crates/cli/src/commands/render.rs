@@ -32,6 +32,10 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Memory budget (bytes, or with a suffix: 512M, 8G); a frame estimated to need more is
+    /// refused before anything is allocated [default: half the physical memory].
+    #[arg(long, value_name = "BYTES", value_parser = sss_render::budget::parse_bytes)]
+    pub max_memory: Option<u64>,
     /// Directory to search for meshes (repeatable; SSS_MESH_DIR is searched too).
     #[arg(long, value_name = "DIR")]
     pub mesh_dir: Vec<PathBuf>,
@@ -136,6 +140,9 @@ pub fn run(args: &RenderArgs) -> Result<String, Error> {
     }
     let settings = RenderSettings {
         seed: args.seed,
+        max_memory: args
+            .max_memory
+            .unwrap_or_else(sss_render::budget::default_budget),
         ..RenderSettings::default()
     };
     let pool = rayon::ThreadPoolBuilder::new()

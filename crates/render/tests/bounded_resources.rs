@@ -1,7 +1,9 @@
-//! Caps that bind and implausible units are reported as warnings in the render output (the
+//! Bounded resources: a frame over the memory budget is refused before anything is allocated,
+//! and caps that bind and implausible units are reported as warnings in the render output (the
 //! CLI prints them as `warning:` lines, `compare` marks the runs), with the requested and the
 //! effective value and how to lift the cap.
 
+use sss_render::budget::{BYTES_PER_PIXEL, BYTES_PER_SAMPLE};
 use sss_render::integrators::exact::Exact;
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::progress::NoProgress;
@@ -157,4 +159,53 @@ fn implausible_units_warn_naming_object_material_and_units() {
         "{:?}",
         out.warnings
     );
+}
+
+/// The example — 100000² pixels — and a budget one byte short of a small frame are
+/// refused with one error naming the input, the bytes and the budget; a budget that fits
+/// renders.
+#[test]
+fn frames_over_the_memory_budget_are_refused_before_allocation() {
+    let mut scene = sphere_scene(0.1);
+    let (w, h) = (scene.camera.width as u64, scene.camera.height as u64);
+    let needed = w * h * (BYTES_PER_SAMPLE + BYTES_PER_PIXEL);
+    let tight = RenderSettings {
+        max_memory: needed - 1,
+        ..RenderSettings::default()
+    };
+    let e = render(&scene, &Exact::default(), &tight, &NoProgress)
+        .expect_err("over budget")
+        .to_string();
+    assert!(
+        e.contains("resolution 24x18") && e.contains("--max-memory"),
+        "{e}"
+    );
+    assert!(e.contains(&format!("{needed} bytes")), "{e}");
+    assert!(
+        e.contains(&format!("budget of {} bytes", needed - 1)),
+        "{e}"
+    );
+    let enough = RenderSettings {
+        max_memory: needed,
+        ..RenderSettings::default()
+    };
+    assert!(render(&scene, &Exact::default(), &enough, &NoProgress).is_ok());
+
+    scene.camera.width = 100_000;
+    scene.camera.height = 100_000;
+    let e = render(
+        &scene,
+        &Exact::default(),
+        &RenderSettings::default(),
+        &NoProgress,
+    )
+    .expect_err("10¹⁰ camera samples cannot be held")
+    .to_string();
+    assert!(e.contains("resolution 100000x100000"), "{e}");
+    scene.camera.width = 40_000;
+    scene.camera.height = 40_000;
+    let e = render(&scene, &Exact::default(), &tight, &NoProgress)
+        .expect_err("over budget")
+        .to_string();
+    assert!(e.contains("over the memory budget"), "{e}");
 }
