@@ -7,11 +7,12 @@ use sss_bssrdf::{Medium, ModelKind};
 use sss_cli::profile_table::{MediumSpec, ProfileModel, ProfileRequest, compute};
 use std::path::PathBuf;
 
-const MODELS: [ProfileModel; 4] = [
+const MODELS: [ProfileModel; 5] = [
     ProfileModel::StandardDipole,
     ProfileModel::BetterDipole,
     ProfileModel::DirectionalDipole,
     ProfileModel::Pbd,
+    ProfileModel::Burley,
 ];
 
 fn request(model: ProfileModel, preset: &str, r_max: f64, steps: usize) -> ProfileRequest {

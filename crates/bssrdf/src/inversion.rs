@@ -3,7 +3,7 @@
 //!
 //! This is the artist-facing parameterisation of pbrt's `kdsubsurface` (which inverts the
 //! tabulated ρ_eff with `InvertCatmullRom`) and of appleseed and Cycles. We invert any of the
-//! four models with bisection on the single-scattering albedo ρ ∈ [0, 1]: every model's total
+//! five models with bisection on the single-scattering albedo ρ ∈ [0, 1]: every model's total
 //! reflectance is non-decreasing in ρ, bisection needs nothing else, and 200 halvings reach
 //! the resolution of f64, so the round trip reflectance → medium → reflectance is exact to the
 //! model's own evaluation.

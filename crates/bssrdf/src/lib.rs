@@ -1,7 +1,7 @@
 //! # sss-bssrdf: BSSRDF models for subsurface scattering
 //!
 //! Use this crate when you need the *physics* of translucent materials (skin, marble, milk,
-//! wax) and nothing else: a validated [`Medium`], exact [`fresnel`] terms, four diffusion
+//! wax) and nothing else: a validated [`Medium`], exact [`fresnel`] terms, five diffusion
 //! models behind one [`Bssrdf`] trait, importance sampling of their radial profiles, and a
 //! Monte Carlo photon random walk ([`monte_carlo`]) that is the ground truth the models are
 //! measured against. It depends on no renderer; everything is `f64`, and every constructor
@@ -39,6 +39,9 @@
 //! - Habel, Christensen, Jarosz. *Photon Beam Diffusion: A Hybrid Monte Carlo Method for
 //!   Subsurface Scattering.* EGSR 2013, tabulated as in Pharr, Jakob, Humphreys, *Physically
 //!   Based Rendering* 3rd ed. §11.4.2, §15.4-15.5 — [`PhotonBeamDiffusion`].
+//! - Christensen, Burley. *Approximate Reflectance Profiles for Efficient Subsurface
+//!   Scattering.* Pixar Technical Memo #15-04, 2015 — normalized diffusion
+//!   ([`ChristensenBurley`]).
 //! - Wang, Jacques, Zheng. *MCML — Monte Carlo modeling of light transport in multi-layered
 //!   tissues.* 1995 — the photon random walk in [`monte_carlo`].
 
@@ -48,6 +51,7 @@
 
 pub mod better_dipole;
 pub mod catmull_rom;
+pub mod christensen_burley;
 pub mod directional_dipole;
 mod error;
 pub mod fresnel;
@@ -64,6 +68,7 @@ use std::fmt;
 use std::str::FromStr;
 
 pub use better_dipole::BetterDipole;
+pub use christensen_burley::{BurleyFit, ChristensenBurley};
 pub use directional_dipole::DirectionalDipole;
 pub use error::BssrdfError;
 pub use glam::DVec3;
@@ -156,7 +161,7 @@ pub fn fresnel_normalization(eta: f64) -> f64 {
     (1.0 - 2.0 * fresnel::fresnel_moment1(eta)).max(f64::MIN_POSITIVE)
 }
 
-/// The four models, by name.
+/// The five models, by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ModelKind {
     /// Jensen et al. 2001.
@@ -167,24 +172,29 @@ pub enum ModelKind {
     DirectionalDipole,
     /// Habel et al. 2013, tabulated as in pbrt.
     PhotonBeamDiffusion,
+    /// Christensen & Burley 2015, normalized diffusion.
+    Burley,
 }
 
 impl ModelKind {
     /// Every model, in the order reports list them.
-    pub const ALL: [ModelKind; 4] = [
+    pub const ALL: [ModelKind; 5] = [
         ModelKind::StandardDipole,
         ModelKind::BetterDipole,
         ModelKind::DirectionalDipole,
         ModelKind::PhotonBeamDiffusion,
+        ModelKind::Burley,
     ];
 
-    /// The command-line name (`standard-dipole`, `better-dipole`, `directional-dipole`, `pbd`).
+    /// The command-line name (`standard-dipole`, `better-dipole`, `directional-dipole`, `pbd`,
+    /// `burley`).
     pub fn name(self) -> &'static str {
         match self {
             ModelKind::StandardDipole => "standard-dipole",
             ModelKind::BetterDipole => "better-dipole",
             ModelKind::DirectionalDipole => "directional-dipole",
             ModelKind::PhotonBeamDiffusion => "pbd",
+            ModelKind::Burley => "burley",
         }
     }
 }
@@ -206,12 +216,14 @@ impl FromStr for ModelKind {
 }
 
 /// Builds the model `kind` for `medium`. Photon beam diffusion shares one table per (g, η)
-/// across all media (built on first use, in parallel).
+/// across all media (built on first use, in parallel); normalized diffusion takes its surface
+/// albedo from the table of (0, η) and uses the default fit [`BurleyFit::SearchlightMfp`].
 pub fn make_model(kind: ModelKind, medium: &Medium) -> Box<dyn Bssrdf> {
     match kind {
         ModelKind::StandardDipole => Box::new(StandardDipole::new(medium.clone())),
         ModelKind::BetterDipole => Box::new(BetterDipole::new(medium.clone())),
         ModelKind::DirectionalDipole => Box::new(DirectionalDipole::new(medium.clone())),
         ModelKind::PhotonBeamDiffusion => Box::new(PhotonBeamDiffusion::new(medium.clone())),
+        ModelKind::Burley => Box::new(ChristensenBurley::new(medium.clone())),
     }
 }

@@ -100,7 +100,7 @@ fn stiff_and_extreme_grid() {
     }
     assert_eq!(
         checked,
-        ETAS.len() * GS.len() * ALBEDOS.len() * SIGMA_T.len() * 4
+        ETAS.len() * GS.len() * ALBEDOS.len() * SIGMA_T.len() * ModelKind::ALL.len()
     );
 }
 

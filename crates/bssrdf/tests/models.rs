@@ -162,6 +162,7 @@ fn reflectance_inversion_round_trips() {
         ModelKind::StandardDipole,
         ModelKind::BetterDipole,
         ModelKind::PhotonBeamDiffusion,
+        ModelKind::Burley,
     ] {
         for (g, eta) in [(0.0, 1.33), (0.5, 1.5)] {
             for &t in &targets {

@@ -41,6 +41,8 @@ pub enum ProfileModel {
     DirectionalDipole,
     /// Photon beam diffusion (Habel et al. 2013), tabulated as in pbrt.
     Pbd,
+    /// Christensen-Burley normalized diffusion (Christensen & Burley 2015).
+    Burley,
     /// The Monte Carlo photon random walk of `sss_bssrdf::monte_carlo`.
     MonteCarlo,
 }
@@ -53,6 +55,7 @@ impl ProfileModel {
             ProfileModel::BetterDipole => Some(ModelKind::BetterDipole),
             ProfileModel::DirectionalDipole => Some(ModelKind::DirectionalDipole),
             ProfileModel::Pbd => Some(ModelKind::PhotonBeamDiffusion),
+            ProfileModel::Burley => Some(ModelKind::Burley),
             ProfileModel::MonteCarlo => None,
         }
     }

@@ -49,24 +49,35 @@ impl ProfileMethod for ModelMethod {
         make_model(self.0, medium)
     }
 
-    /// Photon beam diffusion models single and multiple scattering; the dipoles (including
-    /// the directional dipole) are diffusion models of multiple scattering only.
+    /// Photon beam diffusion models single and multiple scattering, and normalized diffusion
+    /// (Christensen & Burley 2015) is fitted to Monte Carlo profiles of all scattering orders;
+    /// the dipoles (including the directional dipole) are diffusion models of multiple
+    /// scattering only.
     fn reference_part(&self) -> McPart {
         match self.0 {
-            ModelKind::PhotonBeamDiffusion => McPart::All,
-            _ => McPart::Multiple,
+            ModelKind::PhotonBeamDiffusion | ModelKind::Burley => McPart::All,
+            ModelKind::StandardDipole | ModelKind::BetterDipole | ModelKind::DirectionalDipole => {
+                McPart::Multiple
+            }
         }
     }
 
     fn cold_build_seconds(&self, medium: &Medium) -> f64 {
         // Warm the shared caches, then time a build that redoes the cached part explicitly:
         // photon beam diffusion shares its table per (g, η); that table is its real cost.
+        // Normalized diffusion takes its surface albedo from the table of (0, η).
         black_box(self.build(medium));
         (0..3)
             .map(|_| {
                 let t0 = Instant::now();
-                if self.0 == ModelKind::PhotonBeamDiffusion {
-                    black_box(PbdTable::new(medium.g(), medium.eta()));
+                match self.0 {
+                    ModelKind::PhotonBeamDiffusion => {
+                        black_box(PbdTable::new(medium.g(), medium.eta()));
+                    }
+                    ModelKind::Burley => {
+                        black_box(PbdTable::new(0.0, medium.eta()));
+                    }
+                    _ => {}
                 }
                 black_box(self.build(medium));
                 t0.elapsed().as_secs_f64()
@@ -519,12 +530,14 @@ impl Experiment for ProfileComparison {
              The dipoles (standard, better, directional) are diffusion models of multiple \
              scattering, so they are compared with the Monte Carlo multiple-scattering part \
              (`multiple`: everything minus the photons that escaped after exactly one \
-             collision); photon beam diffusion models single and multiple scattering and is \
+             collision); photon beam diffusion models single and multiple scattering and \
+             normalized diffusion (`burley`) is fitted to profiles of all orders, so both are \
              compared with everything (`all`). Standard errors are those of the full tally.\n\
              - *ns / eval*: wall-clock time of one `rd(ch, r)` call at the bin centres, best of 3 \
              rounds of {TIMING_CALLS}; *ns / RGB eval*: one `rd_rgb(r)`.\n\
              - *cold build*: constructing the model without process-wide caches (for `pbd` this \
-             includes its albedo × radius table).",
+             includes its albedo × radius table, for `burley` the g = 0 table its surface albedo \
+             comes from).",
             100.0 * MAX_REL_SE
         );
         Ok(Section {
