@@ -163,6 +163,21 @@ mod tests {
         assert_eq!(frac_within_se(&image, &image, &reference, &[], 3.0), None);
     }
 
+    /// The threshold is strict (an error of exactly eps is outside), and a black reference
+    /// gives a relative RMSE of 0, never NaN or infinity.
+    #[test]
+    fn boundaries_are_strict_and_finite() {
+        // 1.25·v − v = v/4 exactly for these powers of two.
+        let reference = vec![[4.0, 8.0, 16.0]; 2];
+        let image: Vec<Rgb> = reference.iter().map(|p| p.map(|v| 1.25 * v)).collect();
+        let f = error_figures(&image, &reference, &[0, 1], 0.25);
+        assert_eq!(f.frac_within_eps, 0.0);
+        let black = vec![[0.0; 3]; 2];
+        let g = error_figures(&image, &black, &[0, 1], 0.25);
+        assert!(g.rmse > 0.0);
+        assert_eq!(g.rel_rmse, 0.0);
+    }
+
     #[test]
     fn within_k_standard_errors() {
         let reference = img(&[1.0, 1.0]);
