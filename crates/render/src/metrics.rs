@@ -73,16 +73,17 @@ pub fn error_figures(image: &[Rgb], reference: &[Rgb], pixels: &[usize], eps: f6
 /// Ratio of the image's mean to the reference's over `pixels`, per channel (0 where the
 /// reference's mean is 0).
 pub fn mean_ratio_rgb(image: &[Rgb], reference: &[Rgb], pixels: &[usize]) -> Rgb {
-    let mean = |img: &[Rgb]| -> Rgb {
+    // The means share the pixel count, so their ratio is the ratio of the sums.
+    let sum = |img: &[Rgb]| -> Rgb {
         let mut m = [0.0; 3];
         for &i in pixels {
             for c in 0..3 {
-                m[c] += img[i][c] / pixels.len().max(1) as f64;
+                m[c] += img[i][c];
             }
         }
         m
     };
-    let (ma, mb) = (mean(image), mean(reference));
+    let (ma, mb) = (sum(image), sum(reference));
     [0, 1, 2].map(|c| if mb[c] > 0.0 { ma[c] / mb[c] } else { 0.0 })
 }
 
@@ -176,6 +177,9 @@ mod tests {
         let g = error_figures(&image, &black, &[0, 1], 0.25);
         assert!(g.rmse > 0.0);
         assert_eq!(g.rel_rmse, 0.0);
+        // A channel the reference lacks has ratio 0, the others their true ratio.
+        let no_blue = vec![[4.0, 8.0, 0.0]; 2];
+        assert_eq!(mean_ratio_rgb(&image, &no_blue, &[0, 1]), [1.25, 1.25, 0.0]);
     }
 
     #[test]
