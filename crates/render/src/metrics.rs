@@ -196,5 +196,17 @@ mod tests {
             frac_within_se(&image, &se, &reference, &[0, 1], 1.5),
             Some(0.5)
         );
+        // With a zero error bar, agreement to 1e-12 of a large reference still counts.
+        let big = vec![[1e6, 1.0, 1.0]];
+        let near = vec![[1e6 + 1e-7, 1.0, 1.0]];
+        assert_eq!(
+            frac_within_se(&near, &[[0.0; 3]], &big, &[0], 3.0),
+            Some(1.0)
+        );
+        let off = vec![[1e6 + 1e-5, 1.0, 1.0]];
+        assert_eq!(
+            frac_within_se(&off, &[[0.0; 3]], &big, &[0], 3.0),
+            Some(0.0)
+        );
     }
 }
