@@ -3,8 +3,11 @@
 //! - `cargo xtask compare`: measures every BSSRDF model against the Monte Carlo reference for
 //!   the measured materials and writes `target/compare/report.md`, `results.csv` and plots
 //!   (see [`compare`]).
+//! - `cargo xtask fuzz`: seeded fuzzing of the scene, OBJ and EXR readers and the `sss`
+//!   command line on stable Rust (see [`fuzz`]).
 
 mod compare;
+mod fuzz;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -22,6 +25,38 @@ struct Cli {
 enum Task {
     /// Compare every model with the Monte Carlo reference (errors, totals, cost).
     Compare(CompareArgs),
+    /// Fuzz the scene, OBJ and EXR readers and the `sss` command line with a seeded mutator.
+    Fuzz(FuzzArgs),
+}
+
+/// Arguments of `cargo xtask fuzz`.
+#[derive(Debug, clap::Args)]
+struct FuzzArgs {
+    /// Seed of every mutation (same seed, same inputs).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Most iterations per target [default: 1000 when --seconds is not given].
+    #[arg(long)]
+    iterations: Option<u64>,
+    /// Wall-clock budget over all targets, split evenly between them.
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Which target: scene, obj, exr, cli or all.
+    #[arg(long, default_value = "all", value_parser = ["scene", "obj", "exr", "cli", "all"])]
+    target: String,
+    /// Time limit of one input in milliseconds; longer is reported as a hang.
+    #[arg(long, default_value_t = 10_000)]
+    per_input_ms: u64,
+    /// Output directory: work files, crashes/ and the in-flight input [default:
+    /// WORKSPACE/target/fuzz].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Run one saved input (e.g. target/fuzz/crashes/scene-….bin) on --target.
+    #[arg(long, value_name = "FILE")]
+    replay: Option<PathBuf>,
+    /// Internal: run the fuzzing in this process (the supervising parent passes it).
+    #[arg(long, hide = true)]
+    worker: bool,
 }
 
 /// Arguments of `cargo xtask compare`.
@@ -64,6 +99,50 @@ fn workspace_root() -> PathBuf {
     manifest.parent().map(PathBuf::from).unwrap_or(manifest)
 }
 
+fn fuzz_main(args: FuzzArgs) -> ExitCode {
+    if args.seconds.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
+        eprintln!("error: --seconds must be a non-negative number of seconds");
+        return ExitCode::from(2);
+    }
+    if args.per_input_ms == 0 {
+        eprintln!("error: --per-input-ms must be at least 1");
+        return ExitCode::from(2);
+    }
+    let targets = match args.target.as_str() {
+        "all" => fuzz::targets::Target::ALL.to_vec(),
+        name => fuzz::targets::Target::ALL
+            .into_iter()
+            .filter(|t| t.name() == name)
+            .collect(),
+    };
+    let root = workspace_root();
+    let config = fuzz::Config {
+        seed: args.seed,
+        iterations: args.iterations,
+        seconds: args.seconds,
+        targets,
+        per_input: std::time::Duration::from_millis(args.per_input_ms),
+        out: args.out.unwrap_or_else(|| root.join("target").join("fuzz")),
+        shared_meshes: root.join("..").join("shared").join("meshes"),
+        replay: args.replay,
+    };
+    let result = if args.worker {
+        fuzz::run_worker(&config)
+    } else {
+        let forwarded: Vec<String> = std::env::args().skip(1).collect();
+        fuzz::run_supervised(&config, &forwarded)
+    };
+    match result {
+        Ok(false) => ExitCode::SUCCESS,
+        // Exit at once: a hung input's thread may still be running.
+        Ok(true) => std::process::exit(fuzz::CRASH_STATUS),
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -77,6 +156,7 @@ fn main() -> ExitCode {
         }
     };
     let result = match cli.task {
+        Task::Fuzz(args) => return fuzz_main(args),
         Task::Compare(args) => {
             let presets = match args.presets {
                 Some(p) => p,

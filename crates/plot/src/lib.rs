@@ -401,7 +401,12 @@ fn axis_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     }
     if log {
         lo = lo.max(hi * 10f64.powf(-MAX_LOG_DECADES));
-        let (l, h) = (lo.log10(), hi.log10());
+        // Exponents within ±300 keep both ends (and their padding) normal, finite numbers: a
+        // subnormal end rounded to 0 made plotters' log ticks loop forever.
+        let (l, h) = (
+            lo.log10().clamp(-300.0, 300.0),
+            hi.log10().clamp(-300.0, 300.0),
+        );
         if h - l < 1.0 {
             // Less than a decade: show the enclosing decades so that labelled ticks exist.
             let (fl, ch) = (l.floor(), h.ceil());

@@ -222,14 +222,16 @@ fn cap_warning(scene: &Scene, s: &ObjectSamples, settings: &IrradianceSettings) 
     let ratio = (s.spacing / s.requested_spacing.max(1e-300)).powi(2);
     let needed = (s.samples.len() as f64 * ratio).ceil();
     let needed = if needed < 1e9 {
-        format!("{needed:.0}")
+        format!("about {needed:.0}")
+    } else if needed.is_finite() {
+        format!("about {needed:.1e}")
     } else {
-        format!("{needed:.1e}")
+        "far more than can be placed".to_string()
     };
     format!(
         "object `{}` (material `{material}`): the cap of {} irradiance samples per object bound, \
         so samples are {used_mfp:.3} mean free paths apart instead of the requested {}; raise \
-        --max-samples to about {needed} (or check the material's units_per_mm) to lift it",
+        --max-samples to {needed} (or check the material's units_per_mm) to lift it",
         object.name, settings.max_samples, settings.spacing_mfp
     )
 }

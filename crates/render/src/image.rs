@@ -76,7 +76,8 @@ pub fn write_exr(
 /// Named RGB layers of an image: (layer name, pixels).
 pub type Layers = Vec<(String, Vec<Rgb>)>;
 
-/// Reads every RGB layer of an OpenEXR file, with the image size (width, height).
+/// Reads every RGB layer of an OpenEXR file, with the image size (width, height). The RGB
+/// layers must all have that one size (an error names the file and the layers otherwise).
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Layers), crate::Error> {
     use exr::prelude::*;
     let image = read()
@@ -87,11 +88,10 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Layers), crate::Error> {
         .all_attributes()
         .from_file(path)
         .map_err(|e| io_err(path, "reading", e))?;
-    let mut out = Vec::new();
+    let mut out: self::Layers = Vec::new();
     let mut size = (0, 0);
     for layer in &image.layer_data {
         let (w, h) = (layer.size.0, layer.size.1);
-        size = (w as u32, h as u32);
         let mut px = vec![[0.0f64; 3]; w * h];
         let mut found = 0;
         for ch in &layer.channel_data.list {
@@ -113,6 +113,21 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Layers), crate::Error> {
                 .as_ref()
                 .map(|n| n.to_string())
                 .unwrap_or_default();
+            let this = (w as u32, h as u32);
+            if let Some((first, _)) = out.first()
+                && this != size
+            {
+                return Err(crate::Error::Input(format!(
+                    "{}: layer `{name}` is {}x{} but layer `{first}` is {}x{}; every RGB layer \
+                     must have the same size",
+                    path.display(),
+                    this.0,
+                    this.1,
+                    size.0,
+                    size.1
+                )));
+            }
+            size = this;
             out.push((name, px));
         }
     }
