@@ -237,6 +237,13 @@ fn radial_model_request_names_material_and_model() {
         directional, 1,
         "toad's one material is the directional dipole"
     );
+    // The sphere's skin is the better dipole: radial, so the request succeeds.
+    let scene = small("sphere", 8);
+    let frame = Frame::prepare(&scene, 1);
+    let sh = frame.shading.iter().flatten().next().unwrap();
+    assert!(!sh.directional());
+    let model = sh.radial("dual-tree").unwrap();
+    assert_eq!(model.rd_rgb(0.3), sh.bssrdf().rd_rgb(0.3));
 }
 
 /// Σ_k F_t(η, n·ω_k) E_k · texture, against the terms written out by hand.
