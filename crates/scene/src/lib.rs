@@ -7,7 +7,7 @@
 //! A [`Scene`] is plain data in world space: a pinhole [`Camera`], [`Light`]s, [`Material`]s and
 //! [`Object`]s whose triangle meshes are already transformed, cleaned (degenerate triangles
 //! dropped and counted) and given per-vertex shading normals. The file format (TOML) is
-//! documented in `scenes/README.md`; [`load`] reads it, [`load_str`] parses text, [`builtin`]
+//! documented in `scenes/README.md`; [`load()`] reads it, [`load_str`] parses text, [`builtin`]
 //! returns the scenes embedded in the crate. Every problem is a [`SceneError`] naming the file,
 //! the line and the key; loading never panics on bad input.
 //!
