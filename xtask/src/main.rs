@@ -3,9 +3,12 @@
 //! - `cargo xtask compare`: measures every BSSRDF model against the Monte Carlo reference for
 //!   the measured materials and writes `target/compare/report.md`, `results.csv` and plots
 //!   (see [`compare`]).
+//! - `cargo xtask check-results DIR`: checks the values of a compare run's `results.csv`
+//!   (see [`check_results`]).
 //! - `cargo xtask fuzz`: seeded fuzzing of the scene, OBJ and EXR readers and the `sss`
 //!   command line on stable Rust (see [`fuzz`]).
 
+mod check_results;
 mod compare;
 mod fuzz;
 
@@ -27,6 +30,12 @@ enum Task {
     Compare(CompareArgs),
     /// Fuzz the scene, OBJ and EXR readers and the `sss` command line with a seeded mutator.
     Fuzz(FuzzArgs),
+    /// Check the values in a compare run's results.csv (ranges, thread-count agreement,
+    /// unbiasedness, convergence).
+    CheckResults {
+        /// The compare output directory (holding results.csv).
+        dir: PathBuf,
+    },
 }
 
 /// Arguments of `cargo xtask fuzz`.
@@ -157,6 +166,18 @@ fn main() -> ExitCode {
     };
     let result = match cli.task {
         Task::Fuzz(args) => return fuzz_main(args),
+        Task::CheckResults { dir } => {
+            return match check_results::run(&dir) {
+                Ok(n) => {
+                    println!("check-results: {n} rows of results.csv pass every check");
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            };
+        }
         Task::Compare(args) => {
             let presets = match args.presets {
                 Some(p) => p,
