@@ -58,6 +58,22 @@ pub fn plot_error(e: sss_plot::PlotError) -> Error {
     }
 }
 
+/// A panic's message and location on one line (`message at file:line`), as `sss` reports a
+/// bug and `cargo xtask fuzz` records a crash.
+pub fn panic_message(info: &std::panic::PanicHookInfo<'_>) -> String {
+    let payload = info
+        .payload()
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| info.payload().downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "panic".into());
+    let at = info
+        .location()
+        .map(|l| format!(" at {}:{}", l.file(), l.line()))
+        .unwrap_or_default();
+    format!("{}{at}", payload.replace('\n', " "))
+}
+
 /// Subsurface-scattering toolkit: BSSRDF profiles and measured materials.
 #[derive(Debug, Parser)]
 #[command(name = "sss", version, about)]
@@ -142,20 +158,7 @@ pub fn main(args: impl IntoIterator<Item = OsString>) -> ExitCode {
     };
     // A panic is a bug; report it on one line like every other error.
     std::panic::set_hook(Box::new(|info| {
-        let payload = info
-            .payload()
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| info.payload().downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "panic".into());
-        let at = info
-            .location()
-            .map(|l| format!(" at {}:{}", l.file(), l.line()))
-            .unwrap_or_default();
-        eprintln!(
-            "error: internal error (a bug): {}{at}",
-            payload.replace('\n', " ")
-        );
+        eprintln!("error: internal error (a bug): {}", panic_message(info));
     }));
     let stdout = std::io::stdout();
     let mut lock = stdout.lock();

@@ -3,22 +3,9 @@
 
 use sss_bssrdf::{Medium, ModelKind, make_model, presets::PRESETS};
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-fn sss(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sss"))
-        .args(args)
-        .output()
-        .expect("run sss")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8(o.stdout.clone()).expect("utf-8 stdout")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8(o.stderr.clone()).expect("utf-8 stderr")
-}
+mod common;
+use common::{sss, stderr, stdout};
 
 fn ok(args: &[&str]) -> String {
     let o = sss(args);

@@ -5,12 +5,8 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-fn sss(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sss"))
-        .args(args)
-        .output()
-        .expect("run sss")
-}
+mod common;
+use common::sss;
 
 fn tmp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!(

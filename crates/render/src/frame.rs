@@ -69,7 +69,7 @@ impl<'a> Frame<'a> {
         let shading = timed_into(&mut stages, "models", || shading_for(scene, &visible));
         let warnings = visible
             .iter()
-            .filter_map(|&o| implausible_size(scene, o))
+            .filter_map(|&o| implausible_size(scene, &geom, o))
             .collect();
         Frame {
             scene,
@@ -145,7 +145,7 @@ impl Frame<'_> {
         let samples = Arc::new(self.timed("samples", || {
             irradiance::compute(self.scene, &self.geom, &self.visible, settings, self.seed)
         }));
-        for s in samples.iter().filter(|s| s.capped()) {
+        for s in samples.iter().filter(|s| s.capped(settings)) {
             self.warn(cap_warning(self.scene, s, settings));
         }
         *cache = Some(CachedSamples {
@@ -219,7 +219,7 @@ fn cap_warning(scene: &Scene, s: &ObjectSamples, settings: &IrradianceSettings) 
     let material = &scene.materials[object.material].name;
     let used_mfp = s.spacing / s.mfp.max(1e-300);
     // The count grows as 1/spacing² on a surface.
-    let ratio = (s.spacing / s.requested_spacing.max(1e-300)).powi(2);
+    let ratio = (s.spacing / s.requested_spacing(settings).max(1e-300)).powi(2);
     let needed = (s.samples.len() as f64 * ratio).ceil();
     let needed = if needed < 1e9 {
         format!("about {needed:.0}")
@@ -242,18 +242,10 @@ pub const MAX_PLAUSIBLE_MFP: f64 = 1e4;
 /// A warning when translucent object `o` is smaller than one reduced mean free path across or
 /// larger than [`MAX_PLAUSIBLE_MFP`] of them: almost always a `units_per_mm` mistake (the
 /// model then sees a speck of translucent material, or an opaque wall).
-fn implausible_size(scene: &Scene, o: u32) -> Option<String> {
+fn implausible_size(scene: &Scene, geom: &SceneGeometry, o: u32) -> Option<String> {
     let t = scene.translucent(o as usize)?;
     let object = &scene.objects[o as usize];
-    let mesh = &object.mesh;
-    let (mut lo, mut hi) = (
-        glam::DVec3::splat(f64::INFINITY),
-        glam::DVec3::splat(f64::NEG_INFINITY),
-    );
-    for p in &mesh.positions {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
+    let (lo, hi) = geom.bounds(o)?;
     let size = (hi - lo).max_element();
     if !(size.is_finite() && size > 0.0 && t.units_per_mm > 0.0) {
         return None;

@@ -110,6 +110,11 @@ impl SceneGeometry {
         self.extent
     }
 
+    /// The exact bounding box of object `object`'s usable triangles (None if it has none).
+    pub fn bounds(&self, object: u32) -> Option<(DVec3, DVec3)> {
+        self.objects[object as usize].bvh.bounds()
+    }
+
     /// The mesh of object `i`.
     pub fn mesh(&self, object: u32) -> &Mesh {
         &self.objects[object as usize].mesh

@@ -59,9 +59,6 @@ pub struct ObjectSamples {
     pub object: u32,
     /// Minimum spacing actually used (scene units).
     pub spacing: f64,
-    /// Minimum spacing requested (scene units): `spacing_mfp` × the smallest reduced mean free
-    /// path. Larger `spacing` means the per-object cap bound.
-    pub requested_spacing: f64,
     /// The smallest reduced mean free path of the object's material (scene units).
     pub mfp: f64,
     /// The samples.
@@ -75,9 +72,16 @@ pub struct ObjectSamples {
 }
 
 impl ObjectSamples {
-    /// Whether the per-object cap (`max_samples`) made the samples coarser than requested.
-    pub fn capped(&self) -> bool {
-        self.spacing > self.requested_spacing * (1.0 + 1e-9)
+    /// The minimum spacing `settings` asked for (scene units): `spacing_mfp` × the smallest
+    /// reduced mean free path.
+    pub fn requested_spacing(&self, settings: &IrradianceSettings) -> f64 {
+        settings.spacing_mfp * self.mfp
+    }
+
+    /// Whether the per-object cap (`max_samples`) made the samples coarser than `settings`
+    /// asked for.
+    pub fn capped(&self, settings: &IrradianceSettings) -> bool {
+        self.spacing > self.requested_spacing(settings) * (1.0 + 1e-9)
     }
 
     /// The incident light packets of sample `i` (empty unless the model needs directions).
@@ -175,7 +179,6 @@ pub fn compute(
             Some(ObjectSamples {
                 object: o,
                 spacing: stats.radius,
-                requested_spacing: spacing,
                 mfp: mfp_mm * mat.units_per_mm,
                 samples,
                 incident,

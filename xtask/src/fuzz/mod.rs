@@ -82,20 +82,11 @@ static LAST_PANIC: Mutex<Option<String>> = Mutex::new(None);
 
 fn install_panic_hook() {
     std::panic::set_hook(Box::new(|info| {
-        let payload = info
-            .payload()
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| info.payload().downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "panic".into());
-        let at = info
-            .location()
-            .map(|l| format!(" at {}:{}", l.file(), l.line()))
-            .unwrap_or_default();
+        let message = sss_cli::panic_message(info);
         let mut last = LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner());
         // Keep the first panic of an input (a worker's, not the re-raise on its caller).
         if last.is_none() {
-            *last = Some(format!("{}{at}", payload.replace('\n', " ")));
+            *last = Some(message);
         }
     }));
 }

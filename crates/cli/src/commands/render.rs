@@ -60,16 +60,12 @@ pub fn integrator(method: &str, given: &MethodOptions) -> Result<Box<dyn Integra
     let mut options = MethodOptions::new();
     for name in given.names() {
         if m.options.iter().any(|o| o.name == name) {
-            options = options.with(name, given_value(given, name));
+            options = options.with(name, given.value(name).unwrap_or_default());
         } else {
             eprintln!("warning: --{name} is not an option of method {method}; ignored");
         }
     }
     integrators::build(method, &options)
-}
-
-fn given_value(given: &MethodOptions, name: &str) -> String {
-    given.value(name).unwrap_or_default().to_string()
 }
 
 /// Loads a scene file, or a built-in scene when `name` is not a file but names one.
