@@ -33,10 +33,16 @@
 //! ([`NO_OBJECT`]) output 0. Rows are processed in parallel with rayon; every pixel's value
 //! depends only on the inputs, so the result is identical for any thread count.
 
+mod pixel;
+mod rows;
+
 use crate::error::{SeparableError, ensure};
-use crate::kernel::{Kernel1d, SeparableKernel};
+use crate::kernel::SeparableKernel;
+use pixel::{Pass, PassTaps};
 use rayon::prelude::*;
+use rows::{ChunkTaps, Ctx, Lanes, PixelTable, RowOut, Summary};
 use sss_util::splitmix64;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The `mask` value of pixels that show no translucent object.
 pub const NO_OBJECT: u32 = u32::MAX;
@@ -204,270 +210,17 @@ impl Rules {
         let inv = 1.0 / mm_per_pixel;
         (2.0 * self.support_mm * inv >= self.min_footprint_px && inv.is_finite()).then_some(inv)
     }
-}
 
-/// One pass's taps in f32.
-struct PassTaps {
-    offset: Vec<f32>,
-    weight: Vec<[f32; 3]>,
-    sum: [f32; 3],
-    one_signed: [bool; 3],
-}
-
-impl PassTaps {
-    fn new(k: &Kernel1d) -> PassTaps {
-        let sum = k.sum();
-        let one_signed = std::array::from_fn(|c| {
-            k.taps.iter().all(|t| t.weight[c] >= 0.0) || k.taps.iter().all(|t| t.weight[c] <= 0.0)
-        });
-        PassTaps {
-            offset: k.taps.iter().map(|t| t.offset_mm as f32).collect(),
-            weight: k.taps.iter().map(|t| t.weight.map(|w| w as f32)).collect(),
-            sum: sum.map(|s| s as f32),
-            one_signed,
-        }
-    }
-}
-
-/// Final value of a pixel from the kept accumulation and the dropped weight.
-#[inline(always)]
-fn finish(
-    acc: [f32; 3],
-    dropped: [f32; 3],
-    sum: [f32; 3],
-    one_signed: [bool; 3],
-    centre: [f32; 3],
-) -> [f32; 3] {
-    std::array::from_fn(|c| {
-        let kept = sum[c] - dropped[c];
-        if one_signed[c] && kept * sum[c] > 0.0 && kept.abs() > 1e-6 * sum[c].abs() {
-            acc[c] * (sum[c] / kept)
-        } else {
-            acc[c] + dropped[c] * centre[c]
-        }
-    })
-}
-
-struct Pass<'a> {
-    input: &'a ScreenInput<'a>,
-    src: &'a [[f32; 3]],
-    taps: &'a PassTaps,
-    vertical: bool,
-    rules: Rules,
-    jitter: bool,
-    rotate_limit_mm: f32,
-    seed: u64,
-    /// (cos, sin) of every rotation step.
-    rotations: &'a [(f32, f32)],
-}
-
-/// Running sums of one pixel.
-struct Acc {
-    acc: [f32; 3],
-    dropped: [f32; 3],
-    any_drop: bool,
-}
-
-impl Pass<'_> {
-    /// Whether texel `j` is dropped (another object, or a depth jump).
+    /// [`Rules::inverse_scale`] without branches (so a loop over pixels vectorises): the same
+    /// 1/mm_per_pixel, and whether the pixel is blurred.
     #[inline(always)]
-    fn dropped(&self, j: usize, id: u32, d0: f32) -> bool {
-        let inp = self.input;
-        inp.mask[j] != id || (inp.depth[j] - d0).abs() > self.rules.depth_mm
-    }
-
-    /// Adds texel `j` with weight `bw · wt`, or drops it (zero weights are skipped).
-    #[inline(always)]
-    fn texel(&self, j: usize, bw: f32, wt: &[f32; 3], id: u32, d0: f32, a: &mut Acc) {
-        if bw == 0.0 {
-            return;
-        }
-        let ww = [bw * wt[0], bw * wt[1], bw * wt[2]];
-        if self.dropped(j, id, d0) {
-            a.any_drop = true;
-            for c in 0..3 {
-                a.dropped[c] += ww[c];
-            }
-        } else {
-            let s = self.src[j];
-            for c in 0..3 {
-                a.acc[c] += ww[c] * s[c];
-            }
-        }
-    }
-
-    /// The general per-pixel filter: every texel tested and dropped individually, the kept
-    /// ones renormalised ([`finish`]). Used near silhouettes.
-    #[inline(never)]
-    fn pixel_slow(&self, x: usize, y: usize, id: u32, inv: f32) -> [f32; 3] {
-        let inp = self.input;
-        let w = inp.width;
-        let i = y * w + x;
-        let centre = self.src[i];
-        let t = self.taps;
-        let d0 = inp.depth[i];
-        let (wmax, hmax) = (w as i32 - 1, inp.height as i32 - 1);
-        let mut a = Acc {
-            acc: [0.0; 3],
-            dropped: [0.0; 3],
-            any_drop: false,
-        };
-        let (rdx, rdy) = if self.jitter {
-            let (c, s) = self.rotations[rotation_index(x, y, self.seed)];
-            if self.vertical { (-s, c) } else { (c, s) }
-        } else {
-            (0.0, 0.0)
-        };
-        for (&o_mm, wt) in t.offset.iter().zip(&t.weight) {
-            let o = o_mm * inv;
-            if self.jitter && o_mm.abs() <= self.rotate_limit_mm {
-                // Rotated axis: bilinear fetch at p − o·dir.
-                let (sx, sy) = (x as f32 - o * rdx, y as f32 - o * rdy);
-                let ([j00, j01, j10, j11], fx, fy) = bilinear_cell(sx, sy, w, wmax, hmax);
-                self.texel(j00, (1.0 - fx) * (1.0 - fy), wt, id, d0, &mut a);
-                self.texel(j01, fx * (1.0 - fy), wt, id, d0, &mut a);
-                self.texel(j10, (1.0 - fx) * fy, wt, id, d0, &mut a);
-                self.texel(j11, fx * fy, wt, id, d0, &mut a);
-            } else {
-                // Axis-aligned: linear fetch along the pass's axis.
-                let (p, stride, lim, base) = if self.vertical {
-                    (y as f32 - o, w, hmax, x)
-                } else {
-                    (x as f32 - o, 1, wmax, y * w)
-                };
-                let p0 = floor_i32(p);
-                let f = p - p0 as f32;
-                let j0 = base + p0.clamp(0, lim) as usize * stride;
-                let j1 = base + (p0 + 1).clamp(0, lim) as usize * stride;
-                self.texel(j0, 1.0 - f, wt, id, d0, &mut a);
-                self.texel(j1, f, wt, id, d0, &mut a);
-            }
-        }
-        if !a.any_drop {
-            a.acc
-        } else {
-            finish(a.acc, a.dropped, t.sum, t.one_signed, centre)
-        }
-    }
-
-    /// The common case: every texel the taps read is kept (same object, no depth jump). Sums
-    /// the taps with two linear (or bilinear) fetches each and returns None as soon as a texel
-    /// would be dropped, leaving the pixel to [`Pass::pixel_slow`].
-    #[inline(always)]
-    fn pixel_fast<const VERTICAL: bool, const JITTER: bool>(
-        &self,
-        x: usize,
-        y: usize,
-        id: u32,
-        inv: f32,
-    ) -> Option<[f32; 3]> {
-        let inp = self.input;
-        let (mask, depth, src) = (inp.mask, inp.depth, self.src);
-        let w = inp.width;
-        let d0 = depth[y * w + x];
-        let thr = self.rules.depth_mm;
-        let (wmax, hmax) = (w as i32 - 1, inp.height as i32 - 1);
-        let t = self.taps;
-        let (rdx, rdy) = if JITTER {
-            let (c, s) = self.rotations[rotation_index(x, y, self.seed)];
-            if VERTICAL { (-s, c) } else { (c, s) }
-        } else {
-            (0.0, 0.0)
-        };
-        let kept = |j: usize| mask[j] == id && (depth[j] - d0).abs() <= thr;
-        let (mut r, mut g, mut b) = (0.0f32, 0.0f32, 0.0f32);
-        let centre = src[y * w + x];
-        for (&o_mm, wt) in t.offset.iter().zip(&t.weight) {
-            let o = o_mm * inv;
-            let v = if o_mm == 0.0 {
-                // The centre tap reads the pixel itself, whatever the rotation.
-                centre
-            } else if JITTER && o_mm.abs() <= self.rotate_limit_mm {
-                let (sx, sy) = (x as f32 - o * rdx, y as f32 - o * rdy);
-                let ([j00, j01, j10, j11], fx, fy) = bilinear_cell(sx, sy, w, wmax, hmax);
-                if !(kept(j00) && kept(j01) && kept(j10) && kept(j11)) {
-                    return None;
-                }
-                let (a0, a1, b0, b1) = (src[j00], src[j01], src[j10], src[j11]);
-                let lerp2 = |c: usize| {
-                    let top = a0[c] + fx * (a1[c] - a0[c]);
-                    let bottom = b0[c] + fx * (b1[c] - b0[c]);
-                    top + fy * (bottom - top)
-                };
-                [lerp2(0), lerp2(1), lerp2(2)]
-            } else {
-                let (p, stride, lim) = if VERTICAL {
-                    (y as f32 - o, w, hmax)
-                } else {
-                    (x as f32 - o, 1, wmax)
-                };
-                let base = if VERTICAL { x } else { y * w };
-                let p0 = floor_i32(p);
-                let f = p - p0 as f32;
-                let j0 = base + p0.clamp(0, lim) as usize * stride;
-                let j1 = base + (p0 + 1).clamp(0, lim) as usize * stride;
-                if !(kept(j0) && kept(j1)) {
-                    return None;
-                }
-                let (s0, s1) = (src[j0], src[j1]);
-                [
-                    s0[0] + f * (s1[0] - s0[0]),
-                    s0[1] + f * (s1[1] - s0[1]),
-                    s0[2] + f * (s1[2] - s0[2]),
-                ]
-            };
-            r += wt[0] * v[0];
-            g += wt[1] * v[1];
-            b += wt[2] * v[2];
-        }
-        Some([r, g, b])
-    }
-
-    #[inline(always)]
-    fn pixel<const VERTICAL: bool, const JITTER: bool>(&self, x: usize, y: usize) -> [f32; 3] {
-        let inp = self.input;
-        let i = y * inp.width + x;
-        let id = inp.mask[i];
-        if id == NO_OBJECT {
-            return [0.0; 3];
-        }
-        let Some(inv) = self.rules.inverse_scale(inp.mm_per_pixel[i]) else {
-            let (centre, sum) = (self.src[i], self.taps.sum);
-            return [centre[0] * sum[0], centre[1] * sum[1], centre[2] * sum[2]];
-        };
-        match self.pixel_fast::<VERTICAL, JITTER>(x, y, id, inv) {
-            Some(v) => v,
-            None => self.pixel_slow(x, y, id, inv),
-        }
-    }
-
-    fn run(&self, dst: &mut [[f32; 3]], accumulate: bool) {
-        match (self.vertical, self.jitter) {
-            (false, false) => self.run_as::<false, false>(dst, accumulate),
-            (false, true) => self.run_as::<false, true>(dst, accumulate),
-            (true, false) => self.run_as::<true, false>(dst, accumulate),
-            (true, true) => self.run_as::<true, true>(dst, accumulate),
-        }
-    }
-
-    fn run_as<const VERTICAL: bool, const JITTER: bool>(
-        &self,
-        dst: &mut [[f32; 3]],
-        accumulate: bool,
-    ) {
-        let w = self.input.width;
-        dst.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (x, out) in row.iter_mut().enumerate() {
-                let v = self.pixel::<VERTICAL, JITTER>(x, y);
-                if accumulate {
-                    for c in 0..3 {
-                        out[c] += v[c];
-                    }
-                } else {
-                    *out = v;
-                }
-            }
-        });
+    pub fn inverse_scale_lane(&self, mm_per_pixel: f32) -> (f32, bool) {
+        let inv = 1.0 / mm_per_pixel;
+        let ok = (mm_per_pixel > 0.0)
+            & mm_per_pixel.is_finite()
+            & (2.0 * self.support_mm * inv >= self.min_footprint_px)
+            & inv.is_finite();
+        (inv, ok)
     }
 }
 
@@ -493,6 +246,58 @@ pub fn filter_into(
     opts: &FilterOptions,
     scratch: &mut Vec<[f32; 3]>,
     out: &mut [[f32; 3]],
+) -> Result<(), SeparableError> {
+    run(
+        input,
+        kernel,
+        opts,
+        scratch,
+        out,
+        Evaluation::Rows,
+        &AtomicUsize::new(0),
+    )
+}
+
+/// How the passes are evaluated; both give the same bits.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Evaluation {
+    /// Row chunks with the silhouette test hoisted ([`filter_into`]).
+    Rows,
+    /// [`Evaluation::Rows`] in the x86-64 baseline instruction set even where AVX2 is
+    /// available (both must give the same bits).
+    RowsBaseline,
+    /// Every tap of every pixel fetched and tested on its own: the plain form the chunked one
+    /// is tested against (and measured against in `crates/bench/benches/separable.rs`).
+    PerPixel,
+}
+
+/// [`filter_into`] with a choice of [`Evaluation`], for tests and benchmarks; returns the
+/// fraction of pixel passes that took the row-chunked fast path (0 for
+/// [`Evaluation::PerPixel`]).
+#[doc(hidden)]
+pub fn filter_into_with(
+    input: &ScreenInput,
+    kernel: &SeparableKernel,
+    opts: &FilterOptions,
+    scratch: &mut Vec<[f32; 3]>,
+    out: &mut [[f32; 3]],
+    evaluation: Evaluation,
+) -> Result<f64, SeparableError> {
+    let fast = AtomicUsize::new(0);
+    run(input, kernel, opts, scratch, out, evaluation, &fast)?;
+    let passes = 2 * kernel.terms.len() * input.width * input.height;
+    Ok(fast.into_inner() as f64 / passes.max(1) as f64)
+}
+
+fn run(
+    input: &ScreenInput,
+    kernel: &SeparableKernel,
+    opts: &FilterOptions,
+    scratch: &mut Vec<[f32; 3]>,
+    out: &mut [[f32; 3]],
+    evaluation: Evaluation,
+    fast: &AtomicUsize,
 ) -> Result<(), SeparableError> {
     input.validate()?;
     opts.validate()?;
@@ -520,12 +325,21 @@ pub fn filter_into(
             (c as f32, s as f32)
         })
         .collect();
+    // The chunked form indexes texels in i32 / u32 lanes.
+    let chunked = evaluation != Evaluation::PerPixel && n <= i32::MAX as usize;
+    let baseline = evaluation == Evaluation::RowsBaseline;
+    let tables = chunked.then(|| {
+        (
+            Summary::new(input),
+            PixelTable::new(input, opts.seed, jitter),
+        )
+    });
     for (k, term) in kernel.terms.iter().enumerate() {
         let (h, v) = (
             PassTaps::new(&term.horizontal),
             PassTaps::new(&term.vertical),
         );
-        Pass {
+        let horizontal = Pass {
             input,
             src: input.irradiance,
             taps: &h,
@@ -535,20 +349,75 @@ pub fn filter_into(
             rotate_limit_mm,
             seed: opts.seed,
             rotations: &rotations,
-        }
-        .run(scratch, false);
-        Pass {
-            input,
+        };
+        run_pass(&horizontal, tables.as_ref(), baseline, scratch, false, fast);
+        let vertical = Pass {
             src: scratch,
             taps: &v,
             vertical: true,
-            rules,
-            jitter,
-            rotate_limit_mm,
-            seed: opts.seed,
-            rotations: &rotations,
-        }
-        .run(out, k > 0);
+            ..horizontal
+        };
+        run_pass(&vertical, tables.as_ref(), baseline, out, k > 0, fast);
     }
     Ok(())
+}
+
+/// One pass over every row: `pass.src` into `dst`, added to it when `accumulate`.
+fn run_pass(
+    pass: &Pass,
+    tables: Option<&(Summary, PixelTable)>,
+    baseline: bool,
+    dst: &mut [[f32; 3]],
+    accumulate: bool,
+    fast: &AtomicUsize,
+) {
+    match (pass.vertical, pass.jitter) {
+        (false, false) => rows_of::<false, false>(pass, tables, baseline, dst, accumulate, fast),
+        (false, true) => rows_of::<false, true>(pass, tables, baseline, dst, accumulate, fast),
+        (true, false) => rows_of::<true, false>(pass, tables, baseline, dst, accumulate, fast),
+        (true, true) => rows_of::<true, true>(pass, tables, baseline, dst, accumulate, fast),
+    }
+}
+
+fn rows_of<const VERTICAL: bool, const JITTER: bool>(
+    pass: &Pass,
+    tables: Option<&(Summary, PixelTable)>,
+    baseline: bool,
+    dst: &mut [[f32; 3]],
+    accumulate: bool,
+    fast: &AtomicUsize,
+) {
+    let w = pass.input.width;
+    let rows = dst.par_chunks_mut(w).enumerate();
+    match tables {
+        Some((summary, table)) => {
+            let taps = ChunkTaps::new(pass);
+            let ctx = Ctx {
+                summary,
+                table,
+                taps: &taps,
+                baseline,
+            };
+            rows.for_each_init(Lanes::new, |lanes, (y, row)| {
+                let out = RowOut {
+                    row: row.as_flattened_mut(),
+                    accumulate,
+                };
+                let k = rows::row::<VERTICAL, JITTER>(pass, &ctx, lanes, y, out);
+                fast.fetch_add(k, Ordering::Relaxed);
+            })
+        }
+        None => rows.for_each(|(y, row)| {
+            for (x, o) in row.iter_mut().enumerate() {
+                let v = pass.pixel::<VERTICAL, JITTER>(x, y);
+                if accumulate {
+                    for c in 0..3 {
+                        o[c] += v[c];
+                    }
+                } else {
+                    *o = v;
+                }
+            }
+        }),
+    }
 }
