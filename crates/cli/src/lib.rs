@@ -94,7 +94,7 @@ pub enum Command {
     Render(RenderArgs),
     /// Compare two renders: error figures and a false-colour error map.
     Diff(DiffArgs),
-    /// Export a separable screen-space kernel (JSON, CSV, GLSL or HLSL).
+    /// Export a separable screen-space kernel (JSON, CSV, GLSL, HLSL or WGSL).
     Kernel(KernelArgs),
     /// Run the screen-space separable pass on inputs read from an EXR file.
     Filter(FilterArgs),

@@ -743,6 +743,36 @@ fn kernel_export_conserves_energy() {
         "kernel", "--preset", "marble", "--format", "hlsl", "--taps", "5",
     ]);
     assert!(hlsl.contains("static const float4 sssKernel[5]"), "{hlsl}");
+    // WGSL: the same taps as GLSL, each array with its tap count (naga parses and validates
+    // both in sss-separable's tests/shader_export.rs).
+    for method in ["preintegrated", "svd3"] {
+        let export = |format: &str| {
+            ok(&[
+                "kernel",
+                "--preset",
+                "marble",
+                "--method",
+                method,
+                "--format",
+                format,
+                "--taps",
+                "7",
+                "--normalize",
+            ])
+        };
+        let (glsl, wgsl) = (export("glsl"), export("wgsl"));
+        let taps = |text: &str, ty: &str| -> Vec<String> {
+            text.lines()
+                .filter_map(|l| l.trim().strip_prefix(ty).map(str::to_string))
+                .collect()
+        };
+        let arrays = if method == "svd3" { 6 } else { 1 };
+        assert_eq!(taps(&glsl, "vec4(").len(), 7 * arrays, "{glsl}");
+        assert_eq!(taps(&glsl, "vec4("), taps(&wgsl, "vec4<f32>("), "{wgsl}");
+        assert_eq!(wgsl.matches(": array<vec4<f32>, 7> =").count(), arrays);
+        assert_eq!(wgsl.matches("Taps: u32 = 7u;").count(), arrays);
+        assert_eq!(wgsl.lines().next(), glsl.lines().next());
+    }
     let csv = ok(&[
         "kernel", "--preset", "marble", "--format", "csv", "--taps", "5",
     ]);

@@ -16,6 +16,7 @@
 //! | guided rank-1 optimisation | [`guided`] | 2 | Appendix A, Eq. 7–8 |
 //! | sum of N Gaussians, N = 1..6 | [`gaussians`] | 2N | d'Eon et al. 2007, Eq. 3 |
 //! | importance-sampled / uniform taps | [`taps`] | | §6 |
+//! | a kernel as GLSL / HLSL / WGSL constants | [`shader`] | | |
 //!
 //! Every kernel ends up as the same plain data, a [`SeparableKernel`]: a list of
 //! (horizontal, vertical) [`Kernel1d`] pairs of [`Tap`]s (offset in mm, RGB weights), applied
@@ -61,7 +62,9 @@
 //! - Kernel grids are odd-sized and centred on 0; matrices are row-major with rows along y.
 //! - Jimenez's public separable-SSS shader code (2012) stores a 1D kernel as `float4`s
 //!   `(r, g, b, offset)` with the centre tap first: [`Kernel1d::to_float4`] exports that
-//!   layout (offsets in mm; the shader scales them by its `sssWidth`).
+//!   layout (offsets in mm; the shader scales them by its `sssWidth`), and [`shader`] writes
+//!   it as GLSL, HLSL or WGSL constant arrays (`examples/separable_sss.wgsl` is a WGSL
+//!   two-pass filter that uses them).
 //!
 //! ## Papers implemented
 //! - J. Jimenez, K. Zsolnai, A. Jarabo, C. Freude, T. Auzinger, X.-C. Wu, J. von der Pahlen,
@@ -91,6 +94,7 @@ pub mod kernel2d;
 mod optimize;
 pub mod preintegrated;
 pub mod screen_space;
+pub mod shader;
 mod special;
 pub mod svd;
 pub mod taps;

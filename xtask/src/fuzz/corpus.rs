@@ -426,6 +426,7 @@ impl CliFiles {
             "json",
             "csv",
             "hlsl",
+            "wgsl",
             "--normalize",
             "--uniform",
             "--csv",

@@ -1,6 +1,6 @@
 //! `sss kernel`: exports a separable subsurface-scattering kernel (Jimenez et al. 2015) for a
-//! material as JSON, CSV, or GLSL/HLSL constants in the `float4(r, g, b, offset)` layout of the
-//! public 2012 separable-SSS shader code.
+//! material as JSON, CSV, or GLSL/HLSL/WGSL constants in the `float4(r, g, b, offset)` layout
+//! of the public 2012 separable-SSS shader code.
 //!
 //! Weights: for a rank-1 kernel (every method but `svd3`, `svd6` and `gaussians6`) the exported
 //! taps are the 1D profile a(x) of Eq. 5 whose weights sum to the model's total diffuse
@@ -8,6 +8,12 @@
 //! both passes and divides by R once (or, with `--normalize`, uses weights summing to 1 in both
 //! passes and multiplies by R, or by its own albedo, afterwards). Multi-term kernels export
 //! each term's horizontal and vertical taps as stored (their products sum to R).
+//!
+//! The shader text comes from `sss_separable::shader` (the same constants for engines that use
+//! the library directly): one array `sssKernel` for a rank-1 kernel, `sssKernelH{i}` and
+//! `sssKernelV{i}` per term otherwise; WGSL adds each array's tap count `{name}Taps`, which
+//! WGSL cannot query. `crates/separable/examples/separable_sss.wgsl` is a two-pass compute
+//! shader that applies a pasted WGSL export with the CPU filter's silhouette rules.
 
 use crate::args::MediumArgs;
 use crate::profile_table::{MediumSpec, build_medium};
@@ -16,7 +22,8 @@ use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_render::Error;
 use sss_render::kernel_choice::check_separable_options;
 use sss_render::kernel_choice::{KernelMethod, MaterialKernel, SeparableSettings, build_kernel};
-use sss_separable::{Kernel1d, SeparableKernel, TapPlacement, artist};
+use sss_separable::shader::{self, ShaderLanguage, ShaderTaps};
+use sss_separable::{Energy, Kernel1d, TapPlacement, artist};
 use std::fmt::Write as _;
 
 /// Output formats of `sss kernel`.
@@ -26,10 +33,13 @@ pub enum KernelFormat {
     Json,
     /// `term,direction,offset_mm,weight_r,weight_g,weight_b`.
     Csv,
-    /// GLSL `vec4` array constants.
+    /// GLSL `vec4` array constants (`const vec4 sssKernel[N] = vec4[](...);`).
     Glsl,
-    /// HLSL `float4` array constants.
+    /// HLSL `float4` array constants (`static const float4 sssKernel[N] = {...};`).
     Hlsl,
+    /// WGSL `vec4<f32>` array constants (`const sssKernel: array<vec4<f32>, N> = ...;`) and
+    /// their tap counts (`const sssKernelTaps: u32 = Nu;`).
+    Wgsl,
 }
 
 /// Arguments of `sss kernel`.
@@ -58,58 +68,13 @@ pub struct KernelArgs {
     /// Place taps uniformly instead of by importance (SVD terms always are).
     #[arg(long)]
     pub uniform: bool,
-    /// Output format.
+    /// Output format: json, csv, or shader constants (glsl, hlsl, wgsl) in the
+    /// float4(r, g, b, offset_mm) layout, centre tap first.
     #[arg(long, value_enum, default_value_t = KernelFormat::Json)]
     pub format: KernelFormat,
     /// Scale the weights to sum to 1 instead of the total diffuse reflectance.
     #[arg(long)]
     pub normalize: bool,
-}
-
-/// The exported kernel: rank-1 taps (weights summing to R or 1), or the terms.
-struct Export {
-    method: String,
-    taps: Option<Kernel1d>,
-    terms: Vec<(Kernel1d, Kernel1d)>,
-    total: Rgb,
-}
-
-fn export_of(kernel: &SeparableKernel, method: String, total: Rgb, normalize: bool) -> Export {
-    if kernel.terms.len() == 1 {
-        // A rank-1 kernel of a radial profile has v ∝ h; a = h · R / Σh keeps h's shape, sums
-        // to R, and a(x) a(y) / R = h(x) v(y) because Σh · Σv = R.
-        let h = &kernel.terms[0].horizontal;
-        let sum = h.sum();
-        let scale: Rgb = std::array::from_fn(|c| {
-            let target = if normalize { 1.0 } else { total[c].max(0.0) };
-            if sum[c] > 0.0 { target / sum[c] } else { 0.0 }
-        });
-        return Export {
-            method,
-            taps: Some(h.scaled(scale)),
-            terms: Vec::new(),
-            total,
-        };
-    }
-    let terms = kernel
-        .terms
-        .iter()
-        .map(|t| {
-            if normalize {
-                let inv: Rgb =
-                    std::array::from_fn(|c| if total[c] > 0.0 { 1.0 / total[c] } else { 0.0 });
-                (t.horizontal.clone(), t.vertical.scaled(inv))
-            } else {
-                (t.horizontal.clone(), t.vertical.clone())
-            }
-        })
-        .collect();
-    Export {
-        method,
-        taps: None,
-        terms,
-        total,
-    }
 }
 
 fn num(v: f64) -> String {
@@ -135,30 +100,6 @@ fn taps_json(k: &Kernel1d) -> String {
         })
         .collect();
     format!("[{}]", items.join(", "))
-}
-
-fn float4_array(k: &Kernel1d, glsl: bool, name: &str) -> String {
-    let v = k.to_float4();
-    let items: Vec<String> = v
-        .iter()
-        .map(|f| {
-            let ty = if glsl { "vec4" } else { "float4" };
-            format!("    {ty}({:?}, {:?}, {:?}, {:?})", f[0], f[1], f[2], f[3])
-        })
-        .collect();
-    if glsl {
-        format!(
-            "const vec4 {name}[{}] = vec4[](\n{}\n);\n",
-            v.len(),
-            items.join(",\n")
-        )
-    } else {
-        format!(
-            "static const float4 {name}[{}] = {{\n{}\n}};\n",
-            v.len(),
-            items.join(",\n")
-        )
-    }
 }
 
 /// Runs `sss kernel`: the kernel text for stdout.
@@ -213,36 +154,43 @@ pub fn run(args: &KernelArgs) -> Result<String, Error> {
         None if args.method == KernelMethod::Guided => format!("guided:k={}", args.k),
         None => args.method.to_string(),
     };
-    let e = export_of(&kernel, method, total, args.normalize);
+    let energy = if args.normalize {
+        Energy::Unit
+    } else {
+        Energy::TotalReflectance
+    };
+    let exported = ShaderTaps::new(&kernel, total, energy);
     let mut out = String::new();
     match args.format {
         KernelFormat::Json => {
             let _ = write!(
                 out,
                 "{{\"method\": \"{}\", \"model\": \"{}\", \"normalized\": {}, \"total_diffuse_reflectance\": [{}, {}, {}], \"passes\": {}",
-                e.method,
+                method,
                 args.model,
                 args.normalize,
-                num(e.total[0]),
-                num(e.total[1]),
-                num(e.total[2]),
+                num(total[0]),
+                num(total[1]),
+                num(total[2]),
                 kernel.passes()
             );
-            if let Some(t) = &e.taps {
-                let _ = write!(out, ", \"taps\": {}", taps_json(t));
-            } else {
-                let terms: Vec<String> = e
-                    .terms
-                    .iter()
-                    .map(|(h, v)| {
-                        format!(
-                            "{{\"horizontal\": {}, \"vertical\": {}}}",
-                            taps_json(h),
-                            taps_json(v)
-                        )
-                    })
-                    .collect();
-                let _ = write!(out, ", \"terms\": [{}]", terms.join(", "));
+            match &exported {
+                ShaderTaps::Rank1(t) => {
+                    let _ = write!(out, ", \"taps\": {}", taps_json(t));
+                }
+                ShaderTaps::Terms(terms) => {
+                    let terms: Vec<String> = terms
+                        .iter()
+                        .map(|t| {
+                            format!(
+                                "{{\"horizontal\": {}, \"vertical\": {}}}",
+                                taps_json(&t.horizontal),
+                                taps_json(&t.vertical)
+                            )
+                        })
+                        .collect();
+                    let _ = write!(out, ", \"terms\": [{}]", terms.join(", "));
+                }
             }
             out.push_str("}\n");
         }
@@ -260,21 +208,26 @@ pub fn run(args: &KernelArgs) -> Result<String, Error> {
                     );
                 }
             };
-            if let Some(t) = &e.taps {
-                rows(0, "both", t);
-            } else {
-                for (i, (h, v)) in e.terms.iter().enumerate() {
-                    rows(i, "horizontal", h);
-                    rows(i, "vertical", v);
+            match &exported {
+                ShaderTaps::Rank1(t) => rows(0, "both", t),
+                ShaderTaps::Terms(terms) => {
+                    for (i, t) in terms.iter().enumerate() {
+                        rows(i, "horizontal", &t.horizontal);
+                        rows(i, "vertical", &t.vertical);
+                    }
                 }
             }
         }
-        KernelFormat::Glsl | KernelFormat::Hlsl => {
-            let glsl = args.format == KernelFormat::Glsl;
+        KernelFormat::Glsl | KernelFormat::Hlsl | KernelFormat::Wgsl => {
+            let language = match args.format {
+                KernelFormat::Glsl => ShaderLanguage::Glsl,
+                KernelFormat::Hlsl => ShaderLanguage::Hlsl,
+                _ => ShaderLanguage::Wgsl,
+            };
             let _ = writeln!(
                 out,
                 "// {} kernel of {} ({}), {} taps: float4(r, g, b, offset in mm), centre tap first.",
-                e.method,
+                method,
                 match &spec {
                     MediumSpec::Preset(p) => p.clone(),
                     MediumSpec::Coefficients { .. } => "custom medium".into(),
@@ -290,18 +243,13 @@ pub fn run(args: &KernelArgs) -> Result<String, Error> {
                 } else {
                     "the total diffuse reflectance"
                 },
-                num(e.total[0]),
-                num(e.total[1]),
-                num(e.total[2])
+                num(total[0]),
+                num(total[1]),
+                num(total[2])
             );
-            if let Some(t) = &e.taps {
-                out.push_str(&float4_array(t, glsl, "sssKernel"));
-            } else {
-                for (i, (h, v)) in e.terms.iter().enumerate() {
-                    out.push_str(&float4_array(h, glsl, &format!("sssKernelH{i}")));
-                    out.push_str(&float4_array(v, glsl, &format!("sssKernelV{i}")));
-                }
-            }
+            let text = shader::constants(&exported, language)
+                .map_err(|e| Error::NonFinite(format!("the {} kernel: {e}", args.method)))?;
+            out.push_str(&text);
         }
     }
     Ok(out)
