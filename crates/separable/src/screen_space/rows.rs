@@ -28,10 +28,12 @@ use rayon::prelude::*;
 
 /// Pixels per chunk.
 pub(super) const CHUNK: usize = 64;
+/// Pixels per piece of a chunk that failed the test.
+const SUBCHUNK: usize = 16;
 /// Floats per chunk (RGB).
 const FLOATS: usize = 3 * CHUNK;
 /// Pixels per summary cell.
-const CELL: usize = 32;
+const CELL: usize = 16;
 
 /// One summary cell: a run of up to [`CELL`] pixels of one row.
 #[derive(Clone, Copy, Debug)]
@@ -288,34 +290,49 @@ fn row_any<const VERTICAL: bool, const JITTER: bool>(
     ctx: &Ctx,
     lanes: &mut Lanes,
     y: usize,
-    out: RowOut,
+    mut out: RowOut,
 ) -> usize {
     let w = pass.input.width;
     let (mut x0, mut fast) = (0, 0);
     while x0 < w {
         let n = CHUNK.min(w - x0);
-        let dst = &mut out.row[3 * x0..3 * (x0 + n)];
         if chunk::<VERTICAL, JITTER>(pass, ctx, lanes, x0, y, n) {
-            let acc = &lanes.acc[..3 * n];
-            if out.accumulate {
-                for (d, a) in dst.iter_mut().zip(acc) {
-                    *d += a;
-                }
-            } else {
-                dst.copy_from_slice(acc);
-            }
+            store(&mut out, &lanes.acc[..3 * n], x0);
             fast += n;
         } else {
-            for (l, d) in dst.chunks_exact_mut(3).enumerate() {
-                let v = pass.pixel::<VERTICAL, JITTER>(x0 + l, y);
-                for c in 0..3 {
-                    d[c] = if out.accumulate { d[c] + v[c] } else { v[c] };
+            // Near a silhouette: retry in smaller pieces (each reaches less far across the
+            // pass), then pixel by pixel.
+            let mut s0 = x0;
+            while s0 < x0 + n {
+                let k = SUBCHUNK.min(x0 + n - s0);
+                if chunk::<VERTICAL, JITTER>(pass, ctx, lanes, s0, y, k) {
+                    store(&mut out, &lanes.acc[..3 * k], s0);
+                    fast += k;
+                } else {
+                    for x in s0..s0 + k {
+                        let v = pass.pixel::<VERTICAL, JITTER>(x, y);
+                        store(&mut out, &v, x);
+                    }
                 }
+                s0 += k;
             }
         }
         x0 += n;
     }
     fast
+}
+
+/// Writes (or adds) the RGB values `v` at pixel `x0` of the output row.
+#[inline(always)]
+fn store(out: &mut RowOut, v: &[f32], x0: usize) {
+    let dst = &mut out.row[3 * x0..3 * x0 + v.len()];
+    if out.accumulate {
+        for (d, a) in dst.iter_mut().zip(v) {
+            *d += a;
+        }
+    } else {
+        dst.copy_from_slice(v);
+    }
 }
 
 /// Image coordinates (and tap positions, which stay within w + h of the image) below this

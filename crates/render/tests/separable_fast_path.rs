@@ -1,0 +1,125 @@
+//! The screen-space pass's row-chunked fast path against its per-pixel form on the inputs of
+//! every built-in scene (real silhouettes, depth layers, footprints that change across the
+//! image, several objects and materials): identical bits, at the scenes' resolution and at
+//! 4× it (where kernels span many pixels and most chunks take the fast path).
+
+use sss_render::frame::Frame;
+use sss_render::integrators::separable::screen_buffers;
+use sss_render::kernel_choice::{MaterialKernel, SeparableSettings, build_kernel, filter_options};
+use sss_render::scene::{BUILTIN_SCENES, LoadOptions, builtin};
+use sss_separable::screen_space::{Evaluation, filter_into_with};
+use sss_separable::{NO_OBJECT, ScreenInput};
+
+#[test]
+fn built_in_scenes_filter_identically_on_both_paths() {
+    let mut fast_seen = 0.0f64;
+    for &(name, _) in BUILTIN_SCENES {
+        let Ok(mut scene) = builtin(name, &LoadOptions::from_env()) else {
+            eprintln!("skipping `{name}`: it does not load here (its mesh is not found)");
+            continue;
+        };
+        for scale in [1, 4] {
+            scene.camera.width *= scale;
+            scene.camera.height *= scale;
+            let frame = Frame::prepare(&scene, 3);
+            // Any irradiance does: both paths filter the same input. A texture with detail
+            // at every scale, so a misplaced tap changes the result.
+            let irradiance: Vec<[f64; 3]> = frame
+                .gbuffer
+                .samples
+                .iter()
+                .map(|g| {
+                    let t = (g.p.x * 13.0).sin() * (g.p.y * 7.0).cos() + (g.p.z * 29.0).sin();
+                    [1.5 + t, 1.0 + 0.5 * t, 0.2 + 0.1 * t.abs()]
+                })
+                .collect();
+            let screen = screen_buffers(&frame, &irradiance);
+            let settings = SeparableSettings::default();
+            let opts = filter_options(&settings, 3);
+            let (w, h) = (frame.gbuffer.width as usize, frame.gbuffer.height as usize);
+            for (m, sh) in frame.shading.iter().enumerate() {
+                let Some(sh) = sh else { continue };
+                let MaterialKernel::Separable(kernel) = build_kernel(sh.bssrdf(), &settings)
+                    .unwrap_or_else(|e| panic!("{name}: kernel: {e}"))
+                else {
+                    panic!("{name}: the default kernel is separable");
+                };
+                // The integrator's conversion: the material's pixels, in mm.
+                let u = sh.units_per_mm;
+                let mut e = vec![[0.0f32; 3]; w * h];
+                let mut depth = vec![0.0f32; w * h];
+                let mut mask = vec![NO_OBJECT; w * h];
+                let mut mm = vec![0.0f32; w * h];
+                for i in 0..w * h {
+                    let o = screen.object[i];
+                    if o == NO_OBJECT || scene.objects[o as usize].material != m {
+                        continue;
+                    }
+                    mask[i] = o;
+                    depth[i] = (screen.depth[i] / u) as f32;
+                    mm[i] = (screen.footprint[i] / u) as f32;
+                    e[i] = screen.irradiance[i].map(|v| v as f32);
+                }
+                let input = ScreenInput {
+                    width: w,
+                    height: h,
+                    irradiance: &e,
+                    depth: &depth,
+                    mask: &mask,
+                    mm_per_pixel: &mm,
+                };
+                let run = |evaluation| {
+                    let mut out = vec![[0.0f32; 3]; w * h];
+                    let fast = filter_into_with(
+                        &input,
+                        &kernel,
+                        &opts,
+                        &mut Vec::new(),
+                        &mut out,
+                        evaluation,
+                    )
+                    .unwrap();
+                    (out, fast)
+                };
+                let (rows, fast) = run(Evaluation::Rows);
+                let (reference, _) = run(Evaluation::PerPixel);
+                let different = rows
+                    .iter()
+                    .zip(&reference)
+                    .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+                    .count();
+                let shown = mask.iter().filter(|&&o| o != NO_OBJECT).count();
+                let blurred = mm
+                    .iter()
+                    .zip(&mask)
+                    .filter(|&(&v, &o)| o != NO_OBJECT && 2.0 * kernel.support_mm as f32 / v >= 1.0)
+                    .count();
+                eprintln!(
+                    "{name} ×{scale} material {m}: {w}×{h}, {shown} pixels shown, {blurred} \
+                     blurred, support {:.2} mm, median mm/px {:.3}, fast path {:.1} % of \
+                     their pixel passes",
+                    kernel.support_mm,
+                    {
+                        let mut v: Vec<f32> = mm
+                            .iter()
+                            .zip(&mask)
+                            .filter(|(_, o)| **o != NO_OBJECT)
+                            .map(|(v, _)| *v)
+                            .collect();
+                        v.sort_by(f32::total_cmp);
+                        v.get(v.len() / 2).copied().unwrap_or(0.0)
+                    },
+                    100.0 * fast * (w * h) as f64 / shown.max(1) as f64
+                );
+                // Background pixels are never on the fast path: the share of the shown ones.
+                let share = fast * (w * h) as f64 / shown.max(1) as f64;
+                assert_eq!(different, 0, "{name} ×{scale} material {m}: pixels differ");
+                fast_seen = fast_seen.max(share);
+            }
+            scene.camera.width /= scale;
+            scene.camera.height /= scale;
+        }
+    }
+    // The comparison covered the fast path, not only its fallback.
+    assert!(fast_seen > 0.4, "largest fast-path share {fast_seen}");
+}
