@@ -148,10 +148,8 @@ pub fn vertex_curvatures(
             continue;
         };
         let areas = f.corner_areas();
-        for c in 0..3 {
-            let i = f.v[c];
+        for (&i, &w) in f.v.iter().zip(&areas) {
             let Some((u, v)) = frames[i] else { continue };
-            let w = areas[c];
             if !(w > 0.0) || !w.is_finite() {
                 continue;
             }
