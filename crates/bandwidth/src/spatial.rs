@@ -40,7 +40,7 @@ use crate::BandwidthError;
 use crate::spectrum::{
     DEFAULT_ENERGY_FRACTION, SpectrumGrid, check_fraction, smoothed_bandwidth_2d_cycles_per_mm,
 };
-use sss_bssrdf::{Bssrdf, DVec3, DirectionalDipole, Medium, ModelKind, SurfacePoint};
+use sss_bssrdf::{Bssrdf, DVec3, DirectionalDipole, Medium, ModelKind, SurfacePoint, make_model};
 
 /// Polar angles of incidence (degrees from the normal) over which the directional dipole's B_s
 /// is maximised.
@@ -231,14 +231,46 @@ fn check_channel(ch: usize) -> Result<(), BandwidthError> {
     Ok(())
 }
 
+/// The range of σ'_t (1/mm) in which [`spatial_bandwidth_cycles_per_mm`] evaluates the given
+/// model directly; outside it, it uses the scaling law (see there).
+pub const DIRECT_SIGMA_T_REDUCED: (f64, f64) = (1e-3, 1e3);
+
 /// B_s (cycles per mm) of channel `ch` (0, 1, 2) of `model`: see the module docs for what is
-/// transformed, the regularisation and the grid. Finite for every valid medium (albedo 0 and 1,
-/// tiny and huge coefficients); 0 for a channel whose profile is 0.
+/// transformed, the regularisation and the grid. 0 for a channel whose profile is 0 (no
+/// scattering, or a profile that underflows).
+///
+/// **Extreme coefficients.** The diffusion models are functions of σ·r, so scaling σ_a and σ_s
+/// by c scales B_s by c exactly (a test checks it to 10⁻³). When σ'_t of the channel lies
+/// outside [`DIRECT_SIGMA_T_REDUCED`], where profile values can overflow or underflow f64, B_s
+/// is computed on the built-in model of the same [`ModelKind`] (`sss_bssrdf::make_model`) for
+/// the channel's medium scaled to σ'_t = 1, and multiplied by σ'_t. So the result is finite
+/// for every valid medium, at the price that a custom model (e.g. normalized diffusion with a
+/// non-default fit) is replaced by the built-in one there.
 pub fn spatial_bandwidth_cycles_per_mm(
     model: &dyn Bssrdf,
     ch: usize,
     opts: &SpatialOptions,
 ) -> Result<f64, BandwidthError> {
+    check_channel(ch)?;
+    let medium = model.medium();
+    let scale = medium.sigma_t_reduced(ch);
+    let (lo, hi) = DIRECT_SIGMA_T_REDUCED;
+    if !(scale >= lo && scale <= hi) && scale > 0.0 && scale.is_finite() {
+        let sigma_a = medium.sigma_a()[ch] / scale;
+        let sigma_s = medium.sigma_s()[ch] / scale;
+        let normalised = Medium::new([sigma_a; 3], [sigma_s; 3], medium.g(), medium.eta())
+            .map_err(|e| BandwidthError::InvalidArgument(format!("normalised medium: {e}")))?;
+        let unit = make_model(model.kind(), &normalised);
+        let grid = model_grid(unit.as_ref(), 0, opts)?;
+        let b = spatial_bandwidth_on_grid(unit.as_ref(), 0, &grid, opts)? * scale;
+        return if b.is_finite() {
+            Ok(b)
+        } else {
+            Err(BandwidthError::InvalidArgument(format!(
+                "B_s overflows f64 for σ'_t = {scale} 1/mm"
+            )))
+        };
+    }
     let grid = model_grid(model, ch, opts)?;
     spatial_bandwidth_on_grid(model, ch, &grid, opts)
 }

@@ -153,6 +153,34 @@ fn extreme_media_give_finite_bandwidths() {
 }
 
 #[test]
+fn absurd_coefficients_follow_the_scaling_law() {
+    // Outside σ'_t ∈ [1e-3, 1e3] the profiles over- or underflow f64; B_s still scales as c.
+    let opts = SpatialOptions::default();
+    let unit = Medium::new([0.05; 3], [0.95; 3], 0.0, 1.3).unwrap();
+    for kind in ModelKind::ALL {
+        let b1 =
+            spatial_bandwidth_cycles_per_mm(make_model(kind, &unit).as_ref(), 0, &opts).unwrap();
+        for c in [1e-300, 1e-150, 1e150, 1e300] {
+            let m = Medium::new([0.05 * c; 3], [0.95 * c; 3], 0.0, 1.3).unwrap();
+            let b =
+                spatial_bandwidth_cycles_per_mm(make_model(kind, &m).as_ref(), 0, &opts).unwrap();
+            assert!(
+                b.is_finite() && (b / (c * b1) - 1.0).abs() < 1e-3,
+                "{kind} ×{c}: {b} vs {}",
+                c * b1
+            );
+        }
+        // Wildly different scales per channel, and an albedo of 1e-300.
+        let m = Medium::new([1e150, 1.0, 1e-3], [1e-150, 1e-300, 1e-200], 0.0, 1.3).unwrap();
+        let b = spatial_bandwidths_cycles_per_mm(make_model(kind, &m).as_ref(), &opts).unwrap();
+        assert!(
+            b.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "{kind}: {b:?}"
+        );
+    }
+}
+
+#[test]
 fn bad_options_are_errors() {
     let model = make_model(ModelKind::BetterDipole, &Medium::preset("skin1").unwrap());
     let d = SpatialOptions::default();
