@@ -41,8 +41,9 @@ fn gaussian_profile_matches_the_analytic_95_percent_frequency() {
             )
             .unwrap();
             let rel = (got - expected).abs() / expected;
+            // Measured: −2.8e-4 for every σ.
             assert!(
-                rel < 0.01,
+                rel < 0.002,
                 "σ = {sigma}, floor {floor}: {got} vs {expected} ({rel:.2e})"
             );
         }
