@@ -23,10 +23,18 @@
 //!   the centre pixel's value instead). Either way a constant irradiance is reproduced and no
 //!   light crosses to another object.
 //!
-//! Cost: each tap is two texel reads along the axis (four, bilinear, for rotated taps); a
-//! pixel whose texels all pass the silhouette test takes a branch-light path, the others a
-//! per-texel one. On the CPU this is compute-bound (tens of instructions per tap), far from
-//! the memory bound a GPU's texture units reach; see `crates/bench/benches/separable.rs`.
+//! Evaluation: rows are cut into chunks of 64 pixels (`rows.rs`). A chunk whose pixels all
+//! show one blurred object, and whose taps can only reach texels of that object within the
+//! depth threshold, runs every tap as one loop over the chunk with contiguous reads and no
+//! per-texel tests; that test is hoisted into a per-frame summary of object ids and depth
+//! ranges per 16-pixel cell (and per 8-row band), so a chunk checks a few cells. The others
+//! (near silhouettes, mixed or skipped pixels) retry as 16-pixel pieces, then go pixel by
+//! pixel (`pixel.rs`: the straightforward form, each texel tested). Both forms do the same
+//! IEEE operations in the same order, so the result is identical bit for bit (tested on
+//! synthetic frames and on every built-in scene) and for any thread count. On x86-64 the
+//! chunk loops are also compiled for AVX2 and picked at run time (the only `unsafe` in the
+//! crate, the call into that build after the CPU check). Cost and its breakdown:
+//! `crates/bench/benches/separable.rs` and the README.
 //!
 //! Output: per pixel, the diffuse exitance E ∗ R_d (with [`crate::Energy::TotalReflectance`]
 //! kernels); the caller applies its Fresnel / π factors. Background pixels

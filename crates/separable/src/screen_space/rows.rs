@@ -53,6 +53,30 @@ struct Cell {
 pub(super) struct Summary {
     cols: usize,
     cells: Vec<Cell>,
+    /// `bands[y * cols + c]` combines cells (y..y + BAND, c), for y + BAND ≤ height.
+    bands: Vec<Cell>,
+}
+
+/// Rows per band of the summary (so a vertical pass checks a few bands, not every row).
+const BAND: usize = 8;
+
+impl Cell {
+    /// The cell covering both.
+    #[inline]
+    fn join(self, o: Cell) -> Cell {
+        Cell {
+            id: self.id,
+            uniform: self.uniform && o.uniform && self.id == o.id,
+            dmin: self.dmin.min(o.dmin),
+            dmax: self.dmax.max(o.dmax),
+        }
+    }
+
+    /// Whether the cell shows `id` only, with depths in [lo, hi].
+    #[inline(always)]
+    fn within(&self, id: u32, lo: f32, hi: f32) -> bool {
+        self.uniform & (self.id == id) & (self.dmin >= lo) & (self.dmax <= hi)
+    }
 }
 
 impl Summary {
@@ -90,7 +114,18 @@ impl Summary {
                     };
                 }
             });
-        Summary { cols, cells }
+        let h = input.height;
+        let mut bands = vec![blank; cols * (h + 1).saturating_sub(BAND)];
+        bands
+            .par_chunks_mut(cols.max(1))
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (c, band) in row.iter_mut().enumerate() {
+                    *band = (y + 1..y + BAND)
+                        .fold(cells[y * cols + c], |b, r| b.join(cells[r * cols + c]));
+                }
+            });
+        Summary { cols, cells, bands }
     }
 
     /// The cells holding columns `xs.0..=xs.1` of row `y`.
@@ -117,11 +152,24 @@ impl Summary {
     /// their cells) shows object `id` with a depth in [lo, hi].
     #[inline]
     fn clean(&self, id: u32, ys: (usize, usize), xs: (usize, usize), lo: f32, hi: f32) -> bool {
-        (ys.0..=ys.1).all(|y| {
-            self.cells(y, xs).iter().fold(true, |a, c| {
-                a & c.uniform & (c.id == id) & (c.dmin >= lo) & (c.dmax <= hi)
-            })
-        })
+        let ok = |cells: &[Cell]| cells.iter().fold(true, |a, c| a & c.within(id, lo, hi));
+        if ys.1 + 1 - ys.0 < BAND {
+            return (ys.0..=ys.1).all(|y| ok(self.cells(y, xs)));
+        }
+        // Bands of BAND rows from ys.0, the last one ending at ys.1 (overlaps are harmless).
+        let (c0, c1) = (xs.0 / CELL, xs.1 / CELL);
+        let mut y = ys.0;
+        loop {
+            let start = y.min(ys.1 + 1 - BAND);
+            let r = start * self.cols;
+            if !ok(&self.bands[r + c0..=r + c1]) {
+                return false;
+            }
+            if start + BAND > ys.1 {
+                return true;
+            }
+            y += BAND;
+        }
     }
 }
 
@@ -202,14 +250,10 @@ pub(super) struct Lanes {
     px: [f32; CHUNK],
     /// 1 / mm_per_pixel.
     inv: [f32; CHUNK],
-    /// The lane index, repeated over the three channels.
-    lane3: [f32; FLOATS],
-    /// 1 / mm_per_pixel, repeated over the channels.
-    inv3: [[f32; 3]; CHUNK],
-    /// An axis tap's fractional position and first texel (minus the lane's own offset),
-    /// repeated over the channels.
+    /// An axis tap's first texel (minus the lane's own offset).
+    cell: [f32; CHUNK],
+    /// An axis tap's fractional position (in `fx`), repeated over the channels.
     frac3: [f32; FLOATS],
-    cell3: [f32; FLOATS],
     /// A rotated tap's weighted value per pixel (RGB and a spare float).
     term4: [[f32; 4]; CHUNK],
     /// Rotated axis direction.
@@ -230,10 +274,8 @@ impl Lanes {
             lane: std::array::from_fn(|l| l as f32),
             px: [0.0; CHUNK],
             inv: [0.0; CHUNK],
-            lane3: std::array::from_fn(|i| (i / 3) as f32),
-            inv3: [[0.0; 3]; CHUNK],
+            cell: [0.0; CHUNK],
             frac3: [0.0; FLOATS],
-            cell3: [0.0; FLOATS],
             term4: [[0.0; 4]; CHUNK],
             rdx: [0.0; CHUNK],
             rdy: [0.0; CHUNK],
@@ -356,12 +398,28 @@ fn small_u32(v: f32) -> u32 {
     (v + 8_388_608.0).to_bits() - 0x4B00_0000
 }
 
+/// `dst[3 l + c] = src[l]`: per-pixel values repeated over the three channels, eight pixels
+/// at a time as one fixed shuffle (which compiles to a few vector permutes).
+#[inline(always)]
+fn spread3(src: &[f32], dst: &mut [f32]) {
+    let mut blocks = dst.chunks_exact_mut(24);
+    let mut sources = src.chunks_exact(8);
+    for (d, s) in (&mut blocks).zip(&mut sources) {
+        let s: &[f32; 8] = s.try_into().expect("8 values");
+        let d: &mut [f32; 24] = d.try_into().expect("24 values");
+        *d = std::array::from_fn(|i| s[i / 3]);
+    }
+    for (d, &s) in blocks.into_remainder().chunks_exact_mut(3).zip(sources.remainder()) {
+        d.fill(s);
+    }
+}
+
 /// Texel `j` of a flat RGB image as 4 floats: RGB and the float after it (0 past the end).
 #[inline(always)]
 fn texel4(src: &[f32], j: u32) -> [f32; 4] {
     let i = 3 * j as usize;
-    match src.get(i..i + 4) {
-        Some(s) => [s[0], s[1], s[2], s[3]],
+    match src.get(i..i + 4).and_then(|s| <[f32; 4]>::try_from(s).ok()) {
+        Some(v) => v,
         None => [src[i], src[i + 1], src[i + 2], 0.0],
     }
 }
@@ -459,9 +517,6 @@ fn chunk<const VERTICAL: bool, const JITTER: bool>(
     for l in 0..n {
         lanes.px[l] = x0f + lanes.lane[l];
     }
-    for (v3, &v) in lanes.inv3[..n].iter_mut().zip(&lanes.inv) {
-        *v3 = [v; 3];
-    }
     if JITTER {
         let rot = &ctx.table.rotation[i0..i0 + n];
         for l in 0..n {
@@ -525,18 +580,18 @@ fn chunk<const VERTICAL: bool, const JITTER: bool>(
             }
         } else {
             // Axis-aligned tap: a linear read at p − o along the axis.
-            // Per float (each pixel's three channels get the same values).
-            let inv3 = lanes.inv3[..n].as_flattened();
-            for i in 0..m {
-                let o = o_mm * inv3[i];
-                let p = if VERTICAL { yf } else { x0f + lanes.lane3[i] } - o;
+            // Per pixel, then the fractions repeated over the channels.
+            for l in 0..n {
+                let o = o_mm * lanes.inv[l];
+                let p = if VERTICAL { yf } else { lanes.px[l] } - o;
                 let p0 = floor_small(p);
-                lanes.frac3[i] = p - p0;
-                lanes.cell3[i] = p0 - lanes.lane3[i] * step as f32;
+                lanes.fx[l] = p - p0;
+                lanes.cell[l] = p0 - lanes.lane[l] * step as f32;
             }
-            // cell3 is the first texel's coordinate minus the pixel's own offset in the
+            spread3(&lanes.fx[..n], &mut lanes.frac3[..m]);
+            // cell is the first texel's coordinate minus the pixel's own offset in the
             // chunk: one value for the whole chunk unless the footprint changes across it.
-            let cells = &lanes.cell3[..m];
+            let cells = &lanes.cell[..n];
             let c0f = cells[0];
             // Equal floats here have equal bits (no −0, no NaN): an integer OR reduction,
             // which vectorises where a float comparison fold does not.
@@ -559,7 +614,7 @@ fn chunk<const VERTICAL: bool, const JITTER: bool>(
                 }
             } else {
                 for l in 0..n {
-                    let p0 = lanes.cell3[3 * l] as i32 + (l * step) as i32;
+                    let p0 = lanes.cell[l] as i32 + (l * step) as i32;
                     let (q0, q1) = (p0.clamp(0, lim) as usize, (p0 + 1).clamp(0, lim) as usize);
                     let (j0, j1) = if VERTICAL {
                         (q0 * w + x0 + l, q1 * w + x0 + l)
