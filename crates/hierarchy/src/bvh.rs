@@ -52,6 +52,12 @@ const PAD: f32 = 1.0 / 16384.0;
 /// How far before the clipped entry point the `f32` ray starts (normalised units). Must be
 /// larger than `PAD` plus CwBvh's entry clamp (`1e-4`).
 const BACKOFF: f64 = 1.0 / 512.0;
+/// Meshes with at most this many hittable triangles are not traversed: a loop over their
+/// triangles costs less than setting up the `f32` ray and walking even a one-node tree (a
+/// ground quad is two triangles). The answers are the same, since the traversal's equal brute
+/// force; the one exception is absurd input: a direction so long that its length over the
+/// mesh's half-extent overflows `f64` makes the traversal report a miss, the loop the hit.
+const SMALL_MESH: usize = 4;
 /// CwBvh traversal uses a fixed stack of 32 entries that silently saturates, and the
 /// conversion from the binary tree is recursive; deeper binary trees (pathological
 /// geometry only) stay binary.
@@ -217,9 +223,11 @@ struct PreparedTriangle {
 /// Built once with [`TriangleBvh::new`]. It is immutable afterwards and `Send + Sync`, so
 /// all rayon threads can share one BVH. Traversal uses obvhs' compressed 8-wide BVH (CwBvh,
 /// Ylitie et al. 2017, built with PLOC, Meister & Bittner 2018) in `f32`. Pathologically
-/// deep trees fall back to obvhs' binary BVH. The triangle tests are done in `f64`, and the
-/// results are identical to a brute-force loop over [`intersect_triangle`]. The notes at
-/// the top of `src/bvh.rs` explain why no `f64` hit is ever lost to `f32` rounding.
+/// deep trees fall back to obvhs' binary BVH, and meshes of at most four hittable triangles
+/// (a ground quad) are not traversed at all: a loop over them is cheaper. The triangle tests
+/// are done in `f64`, and the results are identical to a brute-force loop over
+/// [`intersect_triangle`]. The notes at the top of `src/bvh.rs` explain why no `f64` hit is
+/// ever lost to `f32` rounding.
 ///
 /// Degenerate (zero-area) triangles and triangles with non-finite vertices are accepted and
 /// never hit. At most `u32::MAX` triangles are supported.
@@ -464,6 +472,39 @@ impl TriangleBvh {
         Some((bvh, ray, tau_start, k))
     }
 
+    /// Whether a ray can hit anything at all: finite origin and non-zero finite direction, and
+    /// a non-empty, NaN-free range (the checks [`Self::setup_ray`] starts with).
+    #[inline]
+    fn valid_ray(origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> bool {
+        origin.is_finite() && dir.is_finite() && dir != DVec3::ZERO && t_min < t_max
+    }
+
+    /// The closest hit of a small mesh by a loop over its triangles (same test, same tie rule
+    /// as the traversal).
+    fn closest_hit_small(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> Option<Hit> {
+        if !Self::valid_ray(origin, dir, t_min, t_max) {
+            return None;
+        }
+        let mut best: Option<Hit> = None;
+        for (p, &id) in self.prepared.iter().zip(&self.ids) {
+            let Some((t, u, v)) = intersect_pre(origin, dir, p.v0, p.e1, p.e2) else {
+                continue;
+            };
+            if t > t_min
+                && t < t_max
+                && best.is_none_or(|b| t < b.t || (t == b.t && id < b.triangle))
+            {
+                best = Some(Hit {
+                    triangle: id,
+                    t,
+                    u,
+                    v,
+                });
+            }
+        }
+        best
+    }
+
     /// Closest hit with `t_min < t < t_max` along `origin + t * dir`.
     ///
     /// `dir` need not be normalised; `t` is in units of `dir`. Triangles are two-sided.
@@ -471,6 +512,9 @@ impl TriangleBvh {
     /// Exact ties go to the lowest triangle index. To continue a ray from a hit, start at
     /// the hit point with a small positive `t_min` (relative to the scene size).
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> Option<Hit> {
+        if self.ids.len() <= SMALL_MESH {
+            return self.closest_hit_small(origin, dir, t_min, t_max);
+        }
         let (bvh, ray, tau_start, k) = self.setup_ray(origin, dir, t_min, t_max)?;
         let prepared = &self.prepared;
         let ids = &self.ids;
@@ -507,6 +551,13 @@ impl TriangleBvh {
     /// (shadow / visibility rays). Same conventions as [`Self::closest_hit`]; stops at the
     /// first hit found.
     pub fn occluded(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> bool {
+        if self.ids.len() <= SMALL_MESH {
+            return Self::valid_ray(origin, dir, t_min, t_max)
+                && self.prepared.iter().any(|p| {
+                    matches!(intersect_pre(origin, dir, p.v0, p.e1, p.e2),
+                        Some((t, _, _)) if t > t_min && t < t_max)
+                });
+        }
         let Some((bvh, ray, _, _)) = self.setup_ray(origin, dir, t_min, t_max) else {
             return false;
         };

@@ -505,3 +505,106 @@ fn negative_zero_direction_components_hit() {
     assert_eq!(hp, hm);
     assert!(bvh.occluded(origin, minus, 1e-5, f64::INFINITY));
 }
+
+/// Meshes of up to four hittable triangles skip the traversal and loop over their triangles;
+/// five or more are traversed. Both agree with brute force on random rays and ranges, on
+/// rays through the shared diagonal of a quad (exact ties go to the lower index), and reject
+/// invalid rays the same way.
+#[test]
+fn tiny_meshes_agree_with_brute_force_with_and_without_traversal() {
+    let mut g = rng(41);
+    // Two triangles sharing the diagonal from (0, 0) to (1, 1), with different bounding
+    // boxes (so the storage order follows the geometry, not the input order).
+    let quad = vec![
+        [
+            DVec3::ZERO,
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+        ],
+        [
+            DVec3::ZERO,
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(-1.0, 1.0, 0.0),
+        ],
+    ];
+    // The quad in both orders, so that whatever order the triangles are stored in, one of
+    // the two meets the tie with the higher index first.
+    let mut meshes = vec![quad.clone(), vec![quad[1], quad[0]]];
+    for n in 1..=7 {
+        meshes.push(
+            (0..n)
+                .map(|_| {
+                    let a = random_in_cube(&mut g, 1.0);
+                    [
+                        a,
+                        a + random_in_cube(&mut g, 0.8),
+                        a + random_in_cube(&mut g, 0.8),
+                    ]
+                })
+                .collect(),
+        );
+    }
+    let mut ties = 0;
+    for (m, tris) in meshes.iter().enumerate() {
+        let bvh = TriangleBvh::new(tris);
+        for r in 0..3000 {
+            let diagonal = m < 2 && r % 2 == 0;
+            let (o, d, t_min, t_max) = if diagonal {
+                // Through a point of the quad's diagonal (x = y), from above or below.
+                let s = g.random_range(0.05..0.95);
+                let side = if r % 4 == 0 { 3.0 } else { -3.0 };
+                let o = random_in_cube(&mut g, 2.0) + DVec3::Z * side;
+                (o, DVec3::new(s, s, 0.0) - o, 0.0, f64::INFINITY)
+            } else {
+                let t_min = if r % 3 == 0 {
+                    g.random_range(-1.0..0.5)
+                } else {
+                    0.0
+                };
+                let t_max = if r % 5 == 0 {
+                    g.random_range(0.5..2.0)
+                } else {
+                    f64::INFINITY
+                };
+                (
+                    random_in_cube(&mut g, 1.5),
+                    random_dir(&mut g),
+                    t_min,
+                    t_max,
+                )
+            };
+            let want = brute_closest(tris, o, d, t_min, t_max);
+            assert_eq!(
+                bvh.closest_hit(o, d, t_min, t_max),
+                want,
+                "{} triangles",
+                tris.len()
+            );
+            assert_eq!(bvh.occluded(o, d, t_min, t_max), want.is_some());
+            // The diagonal belongs to both triangles: on an exact tie brute force (and the
+            // mesh) keeps the first. (Möller–Trumbore is not watertight: rounding can also
+            // let a ray slip between the two, which brute force then agrees with.)
+            if diagonal && let Some(h) = want {
+                let both = intersect_triangle(o, d, &tris[1]).is_some_and(|x| x.0 == h.t);
+                ties += usize::from(h.triangle == 0 && both);
+            }
+        }
+        let o = DVec3::new(0.2, 0.3, -5.0);
+        // Sanity: on the quad, the valid version of these rays hits.
+        assert!(m >= 2 || bvh.closest_hit(o, DVec3::Z, 0.0, f64::INFINITY).is_some());
+        for (oo, d, a, b) in [
+            (o, DVec3::ZERO, 0.0, f64::INFINITY),
+            (o, DVec3::new(f64::NAN, 0.0, 1.0), 0.0, f64::INFINITY),
+            (o, DVec3::new(0.0, 0.0, f64::INFINITY), 0.0, f64::INFINITY),
+            (DVec3::splat(f64::NAN), DVec3::Z, 0.0, f64::INFINITY),
+            (o, DVec3::Z, f64::NAN, f64::INFINITY),
+            (o, DVec3::Z, 0.0, f64::NAN),
+            (o, DVec3::Z, 5.0, 1.0),
+            (o, DVec3::Z, 1.0, 1.0),
+        ] {
+            assert!(bvh.closest_hit(oo, d, a, b).is_none());
+            assert!(!bvh.occluded(oo, d, a, b));
+        }
+    }
+    assert!(ties > 600, "{ties} ties on the diagonal");
+}

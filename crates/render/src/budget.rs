@@ -14,12 +14,12 @@ use sss_scene::Scene;
 pub const FALLBACK_BUDGET: u64 = 8 << 30;
 
 /// Bytes per pixel sample at the peak of a render: the G-buffer sample while it is gathered
-/// per pixel and again when flattened, plus an integrator's per-sample values, variances and
+/// per run of pixels and again when flattened, plus an integrator's per-sample values, variances and
 /// irradiance (3 × 24 bytes).
 pub const BYTES_PER_SAMPLE: u64 = 2 * std::mem::size_of::<GSample>() as u64 + 72;
 
-/// Bytes per pixel at the peak of a render: the per-pixel sample list header (24) and offset
-/// (4), the output images, coverage and the assembly buffer (~110), and the screen-space
+/// Bytes per pixel at the peak of a render: the hit counts gathered per run of pixels (4, with
+/// 20 to spare) and the offset (4), the output images, coverage and the assembly buffer (~110), and the screen-space
 /// buffers of the separable pass (~200).
 pub const BYTES_PER_PIXEL: u64 = 24 + 4 + 110 + 200;
 

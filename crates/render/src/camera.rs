@@ -75,21 +75,90 @@ impl CameraFrame {
 /// The `n` sample positions inside pixel (px, py): the centre for n = 1, otherwise a jittered
 /// Latin hypercube (n strata on each axis, shuffled), deterministic for the seed and pixel.
 pub fn pixel_samples(seed: u64, pixel: u64, px: u32, py: u32, n: u32) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(n.max(1) as usize);
+    pixel_samples_into(seed, pixel, px, py, n, &mut out);
+    out
+}
+
+/// [`pixel_samples`] written into `out` (cleared first), so that a loop over pixels can reuse
+/// one buffer instead of allocating per pixel. The positions are bit-identical.
+pub fn pixel_samples_into(
+    seed: u64,
+    pixel: u64,
+    px: u32,
+    py: u32,
+    n: u32,
+    out: &mut Vec<(f64, f64)>,
+) {
+    out.clear();
     let (x0, y0) = (px as f64, py as f64);
     if n <= 1 {
-        return vec![(x0 + 0.5, y0 + 0.5)];
+        out.push((x0 + 0.5, y0 + 0.5));
+        return;
     }
     let mut r = rng(seed, Stream::Camera, pixel);
-    let mut perm: Vec<u32> = (0..n).collect();
+    // The y strata, shuffled (Fisher–Yates) in place in the second component.
+    out.extend((0..n).map(|k| (0.0, k as f64)));
     for i in (1..n as usize).rev() {
         let j = r.random_range(0..=i);
-        perm.swap(i, j);
+        let (a, b) = (out[i].1, out[j].1);
+        out[i].1 = b;
+        out[j].1 = a;
     }
-    (0..n)
-        .map(|k| {
+    for (k, s) in out.iter_mut().enumerate() {
+        let fx = (k as f64 + r.random::<f64>()) / n as f64;
+        let fy = (s.1 + r.random::<f64>()) / n as f64;
+        *s = (x0 + fx, y0 + fy);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The jittered Latin hypercube written out directly: shuffle a stratum permutation, then
+    /// jitter within the strata (the order of the random draws defines the positions).
+    fn latin_hypercube(seed: u64, pixel: u64, px: u32, py: u32, n: u32) -> Vec<(f64, f64)> {
+        let (x0, y0) = (px as f64, py as f64);
+        if n <= 1 {
+            return vec![(x0 + 0.5, y0 + 0.5)];
+        }
+        let mut r = rng(seed, Stream::Camera, pixel);
+        let mut perm: Vec<u32> = (0..n).collect();
+        for i in (1..n as usize).rev() {
+            let j = r.random_range(0..=i);
+            perm.swap(i, j);
+        }
+        let mut out = Vec::new();
+        for k in 0..n {
             let fx = (k as f64 + r.random::<f64>()) / n as f64;
             let fy = (perm[k as usize] as f64 + r.random::<f64>()) / n as f64;
-            (x0 + fx, y0 + fy)
-        })
-        .collect()
+            out.push((x0 + fx, y0 + fy));
+        }
+        out
+    }
+
+    #[test]
+    fn pixel_samples_into_reuses_its_buffer_and_matches_the_latin_hypercube() {
+        let mut buf = vec![(f64::NAN, f64::NAN); 40];
+        for n in [0, 1, 2, 3, 7, 16] {
+            for pixel in [0u64, 1, 12345] {
+                let (px, py) = ((pixel % 97) as u32, (pixel / 97) as u32);
+                pixel_samples_into(3, pixel, px, py, n, &mut buf);
+                let want = latin_hypercube(3, pixel, px, py, n);
+                assert_eq!(buf, want, "n {n} pixel {pixel}");
+                assert_eq!(pixel_samples(3, pixel, px, py, n), want);
+                // One sample per stratum on each axis, inside the pixel.
+                let m = n.max(1) as usize;
+                let mut seen = (vec![0; m], vec![0; m]);
+                for &(x, y) in &buf {
+                    let (fx, fy) = (x - px as f64, y - py as f64);
+                    assert!((0.0..1.0).contains(&fx) && (0.0..1.0).contains(&fy));
+                    seen.0[(fx * m as f64) as usize] += 1;
+                    seen.1[(fy * m as f64) as usize] += 1;
+                }
+                assert!(seen.0.iter().chain(&seen.1).all(|&c| c == 1), "n {n}");
+            }
+        }
+    }
 }

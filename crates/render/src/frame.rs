@@ -6,7 +6,7 @@
 use crate::gbuffer::{GBuffer, GSample};
 use crate::geometry::SceneGeometry;
 use crate::irradiance::{self, IrradianceSettings, ObjectSamples};
-use crate::lights::{Receiver, gather};
+use crate::lights::{Incident, Receiver, gather};
 use crate::rng::{Stream, rng};
 use crate::shading::{TranslucentShading, shading_for};
 use sss_bssrdf::Rgb;
@@ -180,6 +180,17 @@ impl Frame<'_> {
 
     /// Direct light reflected by an opaque diffuse surface at `g` towards the camera.
     pub fn shade_opaque(&self, g: &GSample, light_samples: u32) -> Rgb {
+        self.shade_opaque_with(g, light_samples, &mut Vec::new())
+    }
+
+    /// [`Self::shade_opaque`] with a caller's buffer for the incident light (cleared first), so
+    /// that a loop over many samples allocates once. The result is the same.
+    pub fn shade_opaque_with(
+        &self,
+        g: &GSample,
+        light_samples: u32,
+        packets: &mut Vec<Incident>,
+    ) -> Rgb {
         let mat = &self.scene.materials[self.scene.objects[g.object as usize].material];
         let MaterialKind::Diffuse { albedo, texture } = &mat.kind else {
             return [0.0; 3];
@@ -193,17 +204,17 @@ impl Frame<'_> {
         };
         let idx = g.pixel as u64 * self.gbuffer.samples_per_pixel as u64 + g.index as u64;
         let mut r = rng(self.seed, Stream::Opaque, idx);
-        let mut packets = Vec::new();
+        packets.clear();
         gather(
             &self.geom,
             &self.scene.lights,
             Receiver { p: g.p, n, ng },
             light_samples,
             &mut r,
-            &mut packets,
+            packets,
         );
         let mut out = [0.0; 3];
-        for p in &packets {
+        for p in packets.iter() {
             for c in 0..3 {
                 out[c] += albedo[c] * tex[c] / PI * p.e_cos[c];
             }

@@ -2,7 +2,7 @@
 //! object, view direction, distance, pixel footprint). Every integrator shades these same
 //! points, so their images can be subtracted.
 
-use crate::camera::{CameraFrame, pixel_samples};
+use crate::camera::{CameraFrame, pixel_samples_into};
 use crate::geometry::SceneGeometry;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -53,24 +53,42 @@ pub struct GBuffer {
     pub offsets: Vec<u32>,
 }
 
+/// Pixels per parallel task when casting the camera rays: large enough that task overhead
+/// and the per-task buffers are negligible, small enough to balance the load on many cores
+/// (a 1080p frame is about a thousand tasks).
+const CHUNK_PIXELS: usize = 2048;
+
 impl GBuffer {
     /// Casts the camera rays of `scene` (pixel samples seeded by `seed`).
+    ///
+    /// The pixels are cast in parallel in runs of consecutive pixels; each run gathers its
+    /// hits and per-pixel counts into one buffer (no allocation per pixel), and the runs are
+    /// then copied, in parallel, into the one flat `samples` array. The result does not depend
+    /// on the thread count.
     pub fn new(scene: &Scene, geom: &SceneGeometry, seed: u64) -> Self {
         let cam = &scene.camera;
         let frame = CameraFrame::new(cam);
         let (w, h, spp) = (cam.width, cam.height, cam.pixel_samples.max(1));
         let pixel_angle = frame.pixel_angle();
-        let per_pixel: Vec<Vec<GSample>> = (0..w as u64 * h as u64)
+        let pixels = w as usize * h as usize;
+        let runs: Vec<(Vec<GSample>, Vec<u32>)> = (0..pixels.div_ceil(CHUNK_PIXELS))
             .into_par_iter()
-            .map(|i| {
-                let (px, py) = ((i % w as u64) as u32, (i / w as u64) as u32);
-                pixel_samples(seed, i, px, py, spp)
-                    .into_iter()
-                    .enumerate()
-                    .filter_map(|(k, (x, y))| {
+            .map(|c| {
+                let range = c * CHUNK_PIXELS..pixels.min((c + 1) * CHUNK_PIXELS);
+                let mut hits = Vec::with_capacity(range.len() * spp as usize);
+                let mut counts = Vec::with_capacity(range.len());
+                let mut positions = Vec::with_capacity(spp as usize);
+                for i in range {
+                    let (px, py) = ((i % w as usize) as u32, (i / w as usize) as u32);
+                    pixel_samples_into(seed, i as u64, px, py, spp, &mut positions);
+                    let before = hits.len();
+                    for (k, &(x, y)) in positions.iter().enumerate() {
                         let dir = frame.direction(x, y);
-                        let hit = geom.closest_hit(frame.origin(), dir, 0.0, f64::INFINITY)?;
-                        Some(GSample {
+                        let Some(hit) = geom.closest_hit(frame.origin(), dir, 0.0, f64::INFINITY)
+                        else {
+                            continue;
+                        };
+                        hits.push(GSample {
                             pixel: i as u32,
                             index: k as u32,
                             object: hit.object,
@@ -81,18 +99,38 @@ impl GBuffer {
                             wo: -dir,
                             distance: hit.t,
                             footprint: hit.t * pixel_angle,
-                        })
-                    })
-                    .collect()
+                        });
+                    }
+                    counts.push((hits.len() - before) as u32);
+                }
+                (hits, counts)
             })
             .collect();
-        let mut offsets = Vec::with_capacity(per_pixel.len() + 1);
-        let mut samples = Vec::new();
+
+        // Offsets by prefix sums; `run_start[c]` is the index of run c's first sample.
+        let mut offsets = Vec::with_capacity(pixels + 1);
+        let mut run_start = Vec::with_capacity(runs.len() + 1);
+        let mut total = 0u32;
         offsets.push(0);
-        for v in per_pixel {
-            samples.extend(v);
-            offsets.push(samples.len() as u32);
+        for (hits, counts) in &runs {
+            run_start.push(total as usize);
+            for &k in counts {
+                total += k;
+                offsets.push(total);
+            }
+            debug_assert_eq!(total as usize, run_start.last().unwrap_or(&0) + hits.len());
         }
+        run_start.push(total as usize);
+        // Sample j lies in the last run starting at or before j (empty runs are skipped, as
+        // their start equals the next run's).
+        let samples: Vec<GSample> = (0..total as usize)
+            .into_par_iter()
+            .with_min_len(CHUNK_PIXELS)
+            .map(|j| {
+                let c = run_start.partition_point(|&s| s <= j) - 1;
+                runs[c].0[j - run_start[c]]
+            })
+            .collect();
         GBuffer {
             width: w,
             height: h,

@@ -40,6 +40,21 @@ struct ObjectGeometry {
 
 /// Slab test of a ray against an axis-aligned box: does the segment (t_min, t_max) overlap it?
 fn ray_box(lo: DVec3, hi: DVec3, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> bool {
+    ray_box_entry(lo, hi, origin, dir, t_min, t_max).is_some()
+}
+
+/// Slab test of a ray against an axis-aligned box (Kay & Kajiya, "Ray tracing complex scenes",
+/// SIGGRAPH 1986): where the segment (t_min, t_max) enters the box, `None` if it misses it.
+/// The entry is at least `t_min`; no point of the box on the segment has a smaller `t` (up to
+/// the rounding of the slab distances, which the callers' padded boxes absorb).
+fn ray_box_entry(
+    lo: DVec3,
+    hi: DVec3,
+    origin: DVec3,
+    dir: DVec3,
+    t_min: f64,
+    t_max: f64,
+) -> Option<f64> {
     let mut t0 = t_min;
     let mut t1 = t_max;
     for a in 0..3 {
@@ -56,11 +71,15 @@ fn ray_box(lo: DVec3, hi: DVec3, origin: DVec3, dir: DVec3, t_min: f64, t_max: f
             t1 = far;
         }
         if t0 > t1 {
-            return false;
+            return None;
         }
     }
-    true
+    Some(t0)
 }
+
+/// Scenes with up to this many objects are traversed nearest box first (the order is kept in
+/// a fixed array on the stack); larger ones in index order.
+const MAX_SORTED_OBJECTS: usize = 16;
 
 impl SceneGeometry {
     /// Builds one BVH per object of `scene`.
@@ -157,7 +176,14 @@ impl SceneGeometry {
         }
     }
 
-    /// The closest surface along the ray with t in (t_min, t_max), over all objects.
+    /// The closest surface along the ray with t in (t_min, t_max), over all objects. Exact
+    /// ties go to the lowest object index, then (within the object) to the lowest triangle
+    /// index.
+    ///
+    /// The objects whose bounding boxes the ray enters are visited nearest entry first, and
+    /// the walk stops at the first box that starts beyond the closest hit so far: a ray that
+    /// hits an object in front of the ground never traverses the ground's BVH. The order
+    /// only saves work; the hit is the same as visiting every object in index order.
     pub fn closest_hit(
         &self,
         origin: DVec3,
@@ -165,6 +191,71 @@ impl SceneGeometry {
         t_min: f64,
         t_max: f64,
     ) -> Option<SurfaceHit> {
+        let best = if self.objects.len() <= MAX_SORTED_OBJECTS {
+            self.closest_sorted(origin, dir, t_min, t_max)
+        } else {
+            self.closest_in_order(origin, dir, t_min, t_max)
+        };
+        best.map(|(i, h)| self.surface_hit(i, h, origin, dir))
+    }
+
+    /// [`Self::closest_hit`] for at most [`MAX_SORTED_OBJECTS`] objects: the BVH hit and its
+    /// object, nearest box first.
+    fn closest_sorted(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        t_max: f64,
+    ) -> Option<(u32, sss_hierarchy::Hit)> {
+        // (box entry, object), sorted by entry (insertion sort: a handful of objects).
+        let mut order = [(0.0f64, 0u32); MAX_SORTED_OBJECTS];
+        let mut n = 0;
+        for (i, o) in self.objects.iter().enumerate() {
+            let Some(entry) = ray_box_entry(o.lo, o.hi, origin, dir, t_min, t_max) else {
+                continue;
+            };
+            let mut j = n;
+            while j > 0 && order[j - 1].0 > entry {
+                order[j] = order[j - 1];
+                j -= 1;
+            }
+            order[j] = (entry, i as u32);
+            n += 1;
+        }
+        let mut best: Option<(u32, sss_hierarchy::Hit)> = None;
+        let mut t_best = t_max;
+        for &(entry, i) in &order[..n] {
+            // Every later box starts at least as far: none can hold a hit closer than t_best
+            // (nor one at t_best, which a box starting beyond it cannot contain).
+            if entry > t_best {
+                break;
+            }
+            // A hit exactly at t_best wins if its object comes first in index order; `next_up`
+            // admits t == t_best (t_best is finite once there is a hit).
+            let limit = match best {
+                Some((b, _)) if i < b => t_best.next_up(),
+                _ => t_best,
+            };
+            if let Some(h) = self.objects[i as usize]
+                .bvh
+                .closest_hit(origin, dir, t_min, limit)
+            {
+                t_best = h.t;
+                best = Some((i, h));
+            }
+        }
+        best
+    }
+
+    /// [`Self::closest_hit`] for any number of objects, in index order.
+    fn closest_in_order(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        t_max: f64,
+    ) -> Option<(u32, sss_hierarchy::Hit)> {
         let mut best: Option<(u32, sss_hierarchy::Hit)> = None;
         let mut t_best = t_max;
         for (i, o) in self.objects.iter().enumerate() {
@@ -176,7 +267,7 @@ impl SceneGeometry {
                 best = Some((i as u32, h));
             }
         }
-        best.map(|(i, h)| self.surface_hit(i, h, origin, dir))
+        best
     }
 
     /// The closest surface of object `object` along the ray, ignoring every other object.

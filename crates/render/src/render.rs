@@ -142,12 +142,19 @@ fn assemble(
     let spp = gb.samples_per_pixel as f64;
     let bg = background(&frame.scene.lights);
     let t = Instant::now();
-    let pixels: Vec<(Rgb, Rgb, f32)> = (0..gb.pixels())
-        .into_par_iter()
-        .map(|i| {
+    let n = gb.pixels();
+    let mut subsurface_px = vec![[0.0; 3]; n];
+    let mut total_px = vec![[0.0; 3]; n];
+    let mut coverage = vec![0.0f32; n];
+    subsurface_px
+        .par_iter_mut()
+        .zip(total_px.par_iter_mut())
+        .zip(coverage.par_iter_mut())
+        .enumerate()
+        .with_min_len(1024)
+        // One light-packet buffer per task for the opaque samples.
+        .for_each_init(Vec::new, |packets, (i, ((sss, total), cov))| {
             let (lo, hi) = (gb.offsets[i] as usize, gb.offsets[i + 1] as usize);
-            let mut sss = [0.0; 3];
-            let mut total = [0.0; 3];
             let mut covered = 0u32;
             for k in lo..hi {
                 let g = &gb.samples[k];
@@ -156,7 +163,7 @@ fn assemble(
                     covered += 1;
                     subsurface[k]
                 } else {
-                    frame.shade_opaque(g, settings.opaque_light_samples)
+                    frame.shade_opaque_with(g, settings.opaque_light_samples, packets)
                 };
                 for c in 0..3 {
                     let v = if v[c].is_finite() && v[c] > 0.0 {
@@ -174,13 +181,8 @@ fn assemble(
             for c in 0..3 {
                 total[c] += bg[c] * misses / spp;
             }
-            (sss, total, covered as f32 / spp as f32)
-        })
-        .collect();
+            *cov = covered as f32 / spp as f32;
+        });
     frame.record("opaque", t.elapsed().as_secs_f64());
-    (
-        pixels.iter().map(|p| p.0).collect(),
-        pixels.iter().map(|p| p.1).collect(),
-        pixels.iter().map(|p| p.2).collect(),
-    )
+    (subsurface_px, total_px, coverage)
 }

@@ -22,6 +22,10 @@ use rayon::prelude::*;
 use sss_bssrdf::Rgb;
 use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
 
+/// Pixels (or samples) per parallel task of the per-pixel loops: enough work per task that the
+/// scheduling cost is negligible.
+const PIXELS_PER_TASK: usize = 4096;
+
 /// The options of `separable` (shared with `sss filter`).
 pub const OPTIONS: [OptionSpec; 5] = [
     OptionSpec {
@@ -159,12 +163,14 @@ impl Integrator for Separable {
                 .samples
                 .par_iter()
                 .enumerate()
-                .map(|(k, g)| {
+                .with_min_len(PIXELS_PER_TASK / 4)
+                // One light-packet buffer per task, cleared per sample.
+                .map_init(Vec::new, |packets, (k, g)| {
                     let Some(sh) = frame.shading_of(g.object) else {
                         return [0.0; 3];
                     };
                     let mut r = rng(frame.seed, Stream::Irradiance, (1u64 << 62) ^ k as u64);
-                    let mut packets = Vec::new();
+                    packets.clear();
                     let at = Receiver {
                         p: g.p,
                         n: g.n,
@@ -176,9 +182,9 @@ impl Integrator for Separable {
                         at,
                         self.light_samples,
                         &mut r,
-                        &mut packets,
+                        packets,
                     );
-                    transmitted_irradiance(&mut packets, g.n, sh.eta, sh.texture_at(g.p))
+                    transmitted_irradiance(packets, g.n, sh.eta, sh.texture_at(g.p))
                 })
                 .collect()
         });
@@ -215,16 +221,22 @@ impl Integrator for Separable {
             let mut depth = vec![0.0f32; w * h];
             let mut mask = vec![NO_OBJECT; w * h];
             let mut mm = vec![0.0f32; w * h];
-            for i in 0..w * h {
-                let o = screen.object[i];
-                if o == NO_OBJECT || scene.objects[o as usize].material != m {
-                    continue;
-                }
-                mask[i] = o;
-                depth[i] = (screen.depth[i] / u) as f32;
-                mm[i] = (screen.footprint[i] / u) as f32;
-                e[i] = screen.irradiance[i].map(|v| v as f32);
-            }
+            e.par_iter_mut()
+                .zip(depth.par_iter_mut())
+                .zip(mask.par_iter_mut())
+                .zip(mm.par_iter_mut())
+                .enumerate()
+                .with_min_len(PIXELS_PER_TASK)
+                .for_each(|(i, (((e, depth), mask), mm))| {
+                    let o = screen.object[i];
+                    if o == NO_OBJECT || scene.objects[o as usize].material != m {
+                        return;
+                    }
+                    *mask = o;
+                    *depth = (screen.depth[i] / u) as f32;
+                    *mm = (screen.footprint[i] / u) as f32;
+                    *e = screen.irradiance[i].map(|v| v as f32);
+                });
             let input = ScreenInput {
                 width: w,
                 height: h,
@@ -245,16 +257,20 @@ impl Integrator for Separable {
                 }
             }
             .map_err(|e| Error::Input(format!("separable filter: {e}")))?;
-            for (k, g) in gb.samples.iter().enumerate() {
-                if scene.objects[g.object as usize].material != m
-                    || screen.object[g.pixel as usize] != g.object
-                {
-                    continue;
-                }
-                let f = filtered[g.pixel as usize];
-                let s = sh.exit_weight(g.n, g.wo);
-                values[k] = [f[0] as f64 * s, f[1] as f64 * s, f[2] as f64 * s];
-            }
+            values
+                .par_iter_mut()
+                .zip(gb.samples.par_iter())
+                .with_min_len(PIXELS_PER_TASK)
+                .for_each(|(value, g)| {
+                    if scene.objects[g.object as usize].material != m
+                        || screen.object[g.pixel as usize] != g.object
+                    {
+                        return;
+                    }
+                    let f = filtered[g.pixel as usize];
+                    let s = sh.exit_weight(g.n, g.wo);
+                    *value = [f[0] as f64 * s, f[1] as f64 * s, f[2] as f64 * s];
+                });
         }
         progress.advance(gb.samples.len() as u64);
         frame.record("shading", t.elapsed().as_secs_f64());
@@ -290,6 +306,8 @@ impl ScreenBuffers {
     /// + 1 with 0 for none; EXR values are kept non-negative).
     pub fn layers(&self) -> Vec<Layer> {
         let surface: Vec<Rgb> = (0..self.depth.len())
+            .into_par_iter()
+            .with_min_len(PIXELS_PER_TASK)
             .map(|i| {
                 let id = if self.object[i] == u32::MAX {
                     0.0
@@ -323,32 +341,39 @@ pub fn screen_buffers(frame: &Frame<'_>, irradiance: &[Rgb]) -> ScreenBuffers {
         footprint: vec![0.0; n],
         object: vec![u32::MAX; n],
     };
-    for i in 0..n {
-        let range = gb.offsets[i] as usize..gb.offsets[i + 1] as usize;
-        let Some(first) = range
-            .clone()
-            .find(|&k| frame.shading_of(gb.samples[k].object).is_some())
-        else {
-            continue;
-        };
-        let o = gb.samples[first].object;
-        let mut count = 0.0;
-        for k in range {
-            let g = &gb.samples[k];
-            if g.object != o {
-                continue;
+    b.irradiance
+        .par_iter_mut()
+        .zip(b.depth.par_iter_mut())
+        .zip(b.footprint.par_iter_mut())
+        .zip(b.object.par_iter_mut())
+        .enumerate()
+        .with_min_len(PIXELS_PER_TASK)
+        .for_each(|(i, (((irr, depth), footprint), object))| {
+            let range = gb.offsets[i] as usize..gb.offsets[i + 1] as usize;
+            let Some(first) = range
+                .clone()
+                .find(|&k| frame.shading_of(gb.samples[k].object).is_some())
+            else {
+                return;
+            };
+            let o = gb.samples[first].object;
+            let mut count = 0.0;
+            for k in range {
+                let g = &gb.samples[k];
+                if g.object != o {
+                    continue;
+                }
+                for c in 0..3 {
+                    irr[c] += irradiance[k][c];
+                }
+                *depth += g.distance;
+                *footprint += g.footprint;
+                count += 1.0;
             }
-            for c in 0..3 {
-                b.irradiance[i][c] += irradiance[k][c];
-            }
-            b.depth[i] += g.distance;
-            b.footprint[i] += g.footprint;
-            count += 1.0;
-        }
-        b.object[i] = o;
-        b.irradiance[i] = b.irradiance[i].map(|v| v / count);
-        b.depth[i] /= count;
-        b.footprint[i] /= count;
-    }
+            *object = o;
+            *irr = irr.map(|v| v / count);
+            *depth /= count;
+            *footprint /= count;
+        });
     b
 }
