@@ -98,107 +98,127 @@ impl PlainBlur {
         }
     }
 
-    /// One row: `out[x] = Σ_t w_t · row(x + o_t)`, where `row(k)` is
-    /// `src[base + k·stride .. +3]` (clamped to the line's `len` pixels).
-    fn line(&self, src: &[f32], out: &mut [f32], base: usize, stride: usize, len: usize) {
-        let w = out.len() / 3;
-        let reach = self
-            .offsets
+    /// The clamped sum at pixel `x` of a line: `Σ_t w_t · line(x + o_t)`, where `line(k)` is
+    /// `src[base + k·stride .. +3]` (k clamped to the line's `len` pixels).
+    #[inline(always)]
+    fn clamped(&self, src: &[f32], x: isize, base: usize, stride: usize, len: usize) -> [f32; 3] {
+        let mut v = [0.0f32; 3];
+        for (&o, wt) in self.offsets.iter().zip(&self.weights) {
+            let k = (x + o).clamp(0, len as isize - 1) as usize;
+            for c in 0..3 {
+                v[c] += wt[c] * src[base + k * stride + c];
+            }
+        }
+        v
+    }
+
+    /// `acc[i] = Σ_t lanes_t[i] · src[start_t + i]` over one block of [`BLOCK`] pixels, with the
+    /// sums in registers.
+    #[inline(always)]
+    fn block(&self, src: &[f32], starts: impl Iterator<Item = usize>, out: &mut [f32]) {
+        let mut acc = [0.0f32; 3 * BLOCK];
+        for (s0, lanes) in starts.zip(&self.lanes) {
+            let s = &src[s0..s0 + 3 * BLOCK];
+            for i in 0..3 * BLOCK {
+                acc[i] += lanes[i] * s[i];
+            }
+        }
+        out.copy_from_slice(&acc);
+    }
+
+    fn reach(&self) -> usize {
+        self.offsets
             .iter()
             .map(|o| o.unsigned_abs())
             .max()
-            .unwrap_or(0);
-        let at = |x: isize, c: usize| {
-            let k = x.clamp(0, len as isize - 1) as usize;
-            src[base + k * stride + c]
-        };
-        let px = |x: usize, out: &mut [f32]| {
-            for c in 0..3 {
-                out[3 * x + c] = self
-                    .offsets
-                    .iter()
-                    .zip(&self.weights)
-                    .map(|(&o, wt)| wt[c] * at(x as isize + o, c))
-                    .sum();
-            }
-        };
-        // Borders pixel by pixel with the clamp; the interior in vectorisable blocks.
+            .unwrap_or(0)
+    }
+
+    /// Row `y` of the horizontal pass.
+    #[inline(always)]
+    fn row_h(&self, src: &[f32], out: &mut [f32], y: usize, w: usize) {
+        let base = 3 * w * y;
+        let reach = self.reach();
         let (lo, hi) = (reach.min(w), w.saturating_sub(reach).max(reach.min(w)));
+        // Borders pixel by pixel with the clamp; the interior in vectorisable blocks.
         for x in (0..lo).chain(hi..w) {
-            px(x, out);
+            let v = self.clamped(src, x as isize, base, 3, w);
+            out[3 * x..3 * x + 3].copy_from_slice(&v);
         }
         let mut x = lo;
         while x + BLOCK <= hi {
-            let o = &mut out[3 * x..3 * (x + BLOCK)];
-            o.fill(0.0);
-            for (&off, lanes) in self.offsets.iter().zip(&self.lanes) {
-                let s0 = base + ((x as isize + off) as usize) * stride;
-                let s = &src[s0..s0 + 3 * BLOCK];
-                for i in 0..3 * BLOCK {
-                    o[i] += lanes[i] * s[i];
-                }
-            }
+            let starts = self
+                .offsets
+                .iter()
+                .map(|&o| base + 3 * (x as isize + o) as usize);
+            self.block(src, starts, &mut out[3 * x..3 * (x + BLOCK)]);
             x += BLOCK;
         }
         for x in x..hi {
-            px(x, out);
+            let v = self.clamped(src, x as isize, base, 3, w);
+            out[3 * x..3 * x + 3].copy_from_slice(&v);
         }
     }
 
-    /// Horizontal pass into `tmp`, vertical pass into `out` (both row-major RGB).
+    /// Row `y` of the vertical pass.
+    #[inline(always)]
+    fn row_v(&self, tmp: &[f32], out: &mut [f32], y: usize, w: usize, h: usize) {
+        let reach = self.reach();
+        if y < reach || y + reach >= h {
+            for x in 0..w {
+                let v = self.clamped(tmp, y as isize, 3 * x, 3 * w, h);
+                out[3 * x..3 * x + 3].copy_from_slice(&v);
+            }
+            return;
+        }
+        let mut x = 0;
+        while x + BLOCK <= w {
+            let starts = self
+                .offsets
+                .iter()
+                .map(|&o| 3 * w * (y as isize + o) as usize + 3 * x);
+            self.block(tmp, starts, &mut out[3 * x..3 * (x + BLOCK)]);
+            x += BLOCK;
+        }
+        for x in x..w {
+            let v = self.clamped(tmp, y as isize, 3 * x, 3 * w, h);
+            out[3 * x..3 * x + 3].copy_from_slice(&v);
+        }
+    }
+
+    /// Horizontal pass into `tmp`, vertical pass into `out` (both row-major RGB), in the AVX2
+    /// build where the CPU has it (as the separable pass does).
     fn run(&self, f: &Frame, tmp: &mut [[f32; 3]], out: &mut [[f32; 3]]) {
         let (w, h) = (f.width, f.height);
         let src = f.irradiance.as_flattened();
         tmp.as_flattened_mut()
             .par_chunks_mut(3 * w)
             .enumerate()
-            .for_each(|(y, row)| self.line(src, row, 3 * w * y, 3, w));
+            .for_each(|(y, row)| self.dispatch(|| self.row_h(src, row, y, w)));
         let tmp = tmp.as_flattened();
-        // The vertical pass: the same blocks over the rows above and below (stride = a row).
-        let reach = self
-            .offsets
-            .iter()
-            .map(|o| o.unsigned_abs())
-            .max()
-            .unwrap_or(0);
         out.as_flattened_mut()
             .par_chunks_mut(3 * w)
             .enumerate()
-            .for_each(|(y, row)| {
-                if y < reach || y + reach >= h {
-                    for x in 0..w {
-                        for c in 0..3 {
-                            row[3 * x + c] = self
-                                .offsets
-                                .iter()
-                                .zip(&self.weights)
-                                .map(|(&o, wt)| {
-                                    let yy = (y as isize + o).clamp(0, h as isize - 1) as usize;
-                                    wt[c] * tmp[3 * (yy * w + x) + c]
-                                })
-                                .sum();
-                        }
-                    }
-                    return;
-                }
-                row.fill(0.0);
-                for ((&off, wt), lanes) in self.offsets.iter().zip(&self.weights).zip(&self.lanes) {
-                    let r0 = 3 * w * (y as isize + off) as usize;
-                    let s = &tmp[r0..r0 + 3 * w];
-                    let mut blocks = row.chunks_exact_mut(3 * BLOCK);
-                    let mut sources = s.chunks_exact(3 * BLOCK);
-                    for (o, s) in (&mut blocks).zip(&mut sources) {
-                        for i in 0..3 * BLOCK {
-                            o[i] += lanes[i] * s[i];
-                        }
-                    }
-                    let rest = blocks.into_remainder();
-                    for (i, (o, s)) in rest.iter_mut().zip(sources.remainder()).enumerate() {
-                        *o += wt[i % 3] * s;
-                    }
-                }
-            });
+            .for_each(|(y, row)| self.dispatch(|| self.row_v(tmp, row, y, w, h)));
     }
+
+    #[inline(always)]
+    fn dispatch(&self, f: impl FnOnce()) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe { avx2(f) };
+        }
+        f()
+    }
+}
+
+/// Runs `f` (inlined) compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn avx2(f: impl FnOnce()) {
+    f()
 }
 
 fn pool(threads: usize) -> rayon::ThreadPool {
@@ -235,6 +255,27 @@ fn separable(c: &mut Criterion) {
     });
     let plain = PlainBlur::new(&pre7, 0.5);
     let mut tmp = vec![[0.0f32; 3]; n];
+    // The floor computes what it claims: a few pixels against the clamped sums written out.
+    plain.run(&frame, &mut tmp, &mut out);
+    let (w, h) = (frame.width, frame.height);
+    let first = frame.irradiance.as_flattened();
+    for (x, y) in [(0, 0), (5, 700), (960, 540), (1919, 1079), (1000, 3)] {
+        let mut want = [0.0f64; 3];
+        for (&oy, wy) in plain.offsets.iter().zip(&plain.weights) {
+            let yy = (y as isize + oy).clamp(0, h as isize - 1) as usize;
+            let row = plain.clamped(first, x as isize, 3 * w * yy, 3, w);
+            for c in 0..3 {
+                want[c] += wy[c] as f64 * row[c] as f64;
+            }
+        }
+        for c in 0..3 {
+            let got = out[y * w + x][c] as f64;
+            assert!(
+                (got - want[c]).abs() <= 1e-5 * want[c].abs().max(1e-3),
+                "plain blur ({x},{y})"
+            );
+        }
+    }
     for (name, threads) in [
         ("plain-blur-7taps/1-thread", &one),
         ("plain-blur-7taps/2-threads", &two),
