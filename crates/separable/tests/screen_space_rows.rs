@@ -194,3 +194,26 @@ fn the_fast_path_is_taken_on_clean_frames() {
         }
     }
 }
+
+#[test]
+fn the_benchmark_frame_filters_identically() {
+    // The frame of `crates/bench/benches/separable.rs`: 1080p, one object, 0.5 mm per pixel, a
+    // pore-like texture, a gentle depth ramp, default options, the 7-tap pre-integrated kernel
+    // (here from a 31² kernel grid).
+    let (w, h) = (1920, 1080);
+    let mut f = Frame::flat(w, h, 0.5);
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            f.irradiance[i] = if hash01(x, y) < 0.1 {
+                [0.1; 3]
+            } else {
+                [1.0, 0.9, 0.8]
+            };
+            f.depth[i] = 600.0 + x as f32 * 0.05;
+        }
+    }
+    let (_, kernel) = kernels().remove(0);
+    let fast = assert_same(&f, &kernel, &FilterOptions::default(), "bench frame");
+    assert_eq!(fast, 1.0);
+}
