@@ -138,8 +138,9 @@ const UNIT_TOLERANCE: f64 = 1e-6;
 /// Checks what [`sss_scene::load`] guarantees, for scenes built or edited in code: every light
 /// has finite geometry and finite, non-negative emission (a directional light a unit
 /// direction, a quad light non-parallel edges); every object names an existing material, and
-/// its mesh has at least one triangle, finite positions, one finite unit normal per position
-/// and triangles that index existing vertices. A NaN normal or light would otherwise shade as
+/// its mesh has finite positions, one finite unit normal per position, triangles that index
+/// existing vertices and at least one triangle of non-zero area (degenerate triangles among
+/// others are tolerated: they have no area to be hit or sampled). A NaN normal or light would otherwise shade as
 /// NaN (and be counted as black), an index past the vertices would panic. Returns an
 /// [`Error::Input`](crate::Error::Input) naming the light or object and the problem.
 pub fn check_scene(scene: &Scene) -> Result<(), crate::Error> {
@@ -236,6 +237,17 @@ pub fn check_scene(scene: &Scene) -> Result<(), crate::Error> {
             return fail(format!(
                 "triangle {t} {:?} names a vertex past the {n} positions",
                 m.triangles[t]
+            ));
+        }
+        let has_area = m.triangles.iter().any(|t| {
+            let [a, b, c] = t.map(|v| m.positions[v as usize]);
+            (b - a).cross(c - a).length_squared() > 0.0
+        });
+        if !has_area {
+            return fail(format!(
+                "the mesh has no triangle with non-zero area (all {} repeat a vertex or are \
+                 collinear)",
+                m.triangles.len()
             ));
         }
     }

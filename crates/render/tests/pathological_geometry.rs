@@ -243,10 +243,19 @@ fn a_single_triangle_renders_finite_values_with_every_method() {
         .unwrap();
         assert_eq!(s.objects[0].mesh.triangles.len(), 1);
         for out in render_all(&s) {
-            let covered = out.coverage.iter().filter(|c| **c > 0.0).count();
-            // The triangle spans 2 × 2 units at distance 4 under a 40° field of view: about
-            // (2 / (2·4·tan 20°))² / 2 ≈ 23 % of the frame's height², so well over ten pixels.
-            assert!(covered > 10, "{name} {}: {covered} pixels", out.method);
+            let covered: f64 = out.coverage.iter().map(|&c| c as f64).sum();
+            // Closed form: at distance 4 a 40° field of view spans 2·4·tan 20° = 2.912 units
+            // over 18 rows (and 24/18 of that across), so the triangle's area of 2 units²
+            // covers 2 / (2.912² · 24/18) · 24 · 18 = 76.4 pixels. Its perimeter of 6.47 units
+            // crosses about 40 pixels, each half covered on average: ±20 pixels for the
+            // one-sample-per-pixel coverage.
+            let th = 4.0 * (20.0f64).to_radians().tan() * 2.0;
+            let expected = 2.0 / (th * th * 24.0 / 18.0) * 24.0 * 18.0;
+            assert!(
+                (covered - expected).abs() < 20.0,
+                "{name} {}: {covered} pixels, expected {expected:.1}",
+                out.method
+            );
             if name == "front.obj" {
                 assert!(
                     max_value(&out.subsurface) > 0.0,
@@ -338,6 +347,35 @@ fn a_scene_built_in_code_with_broken_meshes_is_refused_by_render() {
         assert!(matches!(e, sss_render::Error::Input(_)), "{k}: {e:?}");
         assert!(msg.contains("`ball`") && msg.contains(word), "{k}: {msg}");
     }
+    // Degenerate triangles built in code: among good ones they are tolerated (nothing to hit or
+    // sample; the rest of the sphere still renders, finite and lit with every method); a mesh
+    // of nothing else is refused like the loader refuses it.
+    let mut some = good.clone();
+    for t in some.objects[0].mesh.triangles.iter_mut().step_by(3) {
+        t[2] = t[1];
+    }
+    for out in render_all(&some) {
+        assert!(max_value(&out.subsurface) > 0.0, "{}", out.method);
+    }
+    let mut all = good.clone();
+    let m = &mut all.objects[0].mesh;
+    let collinear = [m.positions[0], 2.0 * m.positions[0], 3.0 * m.positions[0]];
+    m.positions[..3].copy_from_slice(&collinear);
+    for (k, t) in m.triangles.iter_mut().enumerate() {
+        *t = if k % 2 == 0 { [0, 1, 2] } else { [5, 5, 7] };
+    }
+    let e = render(
+        &all,
+        exact.as_ref(),
+        &RenderSettings::default(),
+        &NoProgress,
+    )
+    .expect_err("a mesh of degenerate triangles must be refused");
+    assert!(
+        e.to_string().contains("`ball`")
+            && e.to_string().contains("no triangle with non-zero area"),
+        "{e}"
+    );
     // Lights built in code without area, direction or finite power.
     use sss_render::scene::Light;
     for (k, light) in [
@@ -404,7 +442,8 @@ fn a_camera_inside_a_translucent_sphere_renders_finite_values() {
 /// reaches the surface only from inside, travelling outwards. The models take irradiance on the
 /// outside of the surface (E = I cos θ / d² for cos θ > 0, with the surface normal pointing
 /// out), and here cos θ < 0 everywhere, so no light enters: every method must give exactly 0
-/// (finite, and black rather than a light leak). The same light moved outside must light it.
+/// (finite, and black rather than a light leak). The same holds with the light on the surface.
+/// The same light moved outside must light it.
 #[test]
 fn a_light_inside_a_translucent_sphere_is_occluded() {
     let inside = "[[lights]]\ntype = \"point\"\nposition = [0.1, 0.2, 0.0]\nintensity = 10.0\n";
@@ -412,6 +451,20 @@ fn a_light_inside_a_translucent_sphere_is_occluded() {
     for out in render_all(&s) {
         assert_eq!(max_value(&out.subsurface), 0.0, "{}", out.method);
         assert_eq!(max_value(&out.total), 0.0, "{}", out.method);
+    }
+    // On the surface (a vertex of the sphere, and 10⁻⁹ inside it): the segment from any other
+    // surface point to the light is a chord, inside the convex sphere, so cos θ ≤ 0 everywhere
+    // and the closed form is again exactly 0 (and no 1/d² at d = 0 may leak a NaN or Inf).
+    for p in [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0 - 1e-9]] {
+        let l = format!("[[lights]]\ntype = \"point\"\nposition = {p:?}\nintensity = 10.0\n");
+        let s = load(&scene_text([0.0, 0.0, 4.0], &l, SPHERE)).unwrap();
+        assert!(
+            s.objects[0].mesh.positions.contains(&DVec3::Z),
+            "the sphere has a vertex at its pole"
+        );
+        for out in render_all(&s) {
+            assert_eq!(max_value(&out.subsurface), 0.0, "{p:?} {}", out.method);
+        }
     }
     let outside = "[[lights]]\ntype = \"point\"\nposition = [0.0, 0.0, 3.0]\nintensity = 10.0\n";
     let s = load(&scene_text([0.0, 0.0, 4.0], outside, SPHERE)).unwrap();
