@@ -91,14 +91,16 @@ impl RenderOutput {
 }
 
 /// Renders `scene` with `integrator`. `progress` counts shaded G-buffer samples. Fails before
-/// allocating when the frame would not fit `settings.max_memory`, and when the integrator
-/// fails (e.g. a kernel cannot be built, or a method needs a radial model).
+/// allocating when the scene breaks the invariants of its types ([`check_scene`]) or the frame
+/// would not fit `settings.max_memory`, and when the integrator fails (e.g. a kernel cannot be
+/// built, or a method needs a radial model).
 pub fn render(
     scene: &Scene,
     integrator: &dyn Integrator,
     settings: &RenderSettings,
     progress: &dyn Progress,
 ) -> Result<RenderOutput, crate::Error> {
+    check_scene(scene)?;
     crate::budget::check_frame(scene, settings.max_memory)?;
     let frame = Frame::prepare(scene, settings.seed);
     progress.start(frame.gbuffer.samples.len() as u64);
@@ -128,6 +130,128 @@ pub fn render(
         layers: shaded.layers,
         warnings: frame.warnings(),
     })
+}
+
+/// Largest accepted deviation of a shading normal's length from 1.
+const UNIT_TOLERANCE: f64 = 1e-6;
+
+/// Checks what [`sss_scene::load`] guarantees, for scenes built or edited in code: every light
+/// has finite geometry and finite, non-negative emission (a directional light a unit
+/// direction, a quad light non-parallel edges); every object names an existing material, and
+/// its mesh has finite positions, one finite unit normal per position, triangles that index
+/// existing vertices and at least one triangle of non-zero area (degenerate triangles among
+/// others are tolerated: they have no area to be hit or sampled). A NaN normal or light would otherwise shade as
+/// NaN (and be counted as black), an index past the vertices would panic. Returns an
+/// [`Error::Input`](crate::Error::Input) naming the light or object and the problem.
+pub fn check_scene(scene: &Scene) -> Result<(), crate::Error> {
+    use sss_scene::Light;
+    for (i, l) in scene.lights.iter().enumerate() {
+        let (emission, vectors, problem) = match l {
+            Light::Point {
+                position,
+                intensity,
+            } => (intensity, vec![*position], None),
+            Light::Directional {
+                direction,
+                irradiance,
+            } => (
+                irradiance,
+                vec![*direction],
+                ((direction.length() - 1.0).abs() > UNIT_TOLERANCE)
+                    .then_some("the direction is not a unit vector"),
+            ),
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => (
+                radiance,
+                vec![*corner, *edge_u, *edge_v],
+                (edge_u.cross(*edge_v).length() <= 1e-12 * edge_u.length() * edge_v.length())
+                    .then_some("the edges are parallel or zero, so the quad has no area"),
+            ),
+            Light::Environment { radiance } => (radiance, vec![], None),
+        };
+        let problem = if vectors.iter().any(|v| !v.is_finite()) {
+            Some("a position or direction is not finite")
+        } else if emission.iter().any(|e| !(e.is_finite() && *e >= 0.0)) {
+            Some("the emission must be finite and non-negative")
+        } else {
+            problem
+        };
+        if let Some(p) = problem {
+            return Err(crate::Error::Input(format!(
+                "light {i} of scene `{}`: {p} ({l:?})",
+                scene.name
+            )));
+        }
+    }
+    for (i, o) in scene.objects.iter().enumerate() {
+        let fail = |what: String| {
+            Err(crate::Error::Input(format!(
+                "object {i} (`{}`) of scene `{}`: {what}",
+                o.name, scene.name
+            )))
+        };
+        if o.material >= scene.materials.len() {
+            return fail(format!(
+                "material index {} is out of range ({} materials)",
+                o.material,
+                scene.materials.len()
+            ));
+        }
+        let m = &o.mesh;
+        if m.triangles.is_empty() {
+            return fail("the mesh has no triangles".into());
+        }
+        if let Some(k) = m.positions.iter().position(|p| !p.is_finite()) {
+            return fail(format!(
+                "vertex position {k} is not finite: {}",
+                m.positions[k]
+            ));
+        }
+        if m.normals.len() != m.positions.len() {
+            return fail(format!(
+                "the mesh has {} normals for {} positions (one per position needed)",
+                m.normals.len(),
+                m.positions.len()
+            ));
+        }
+        if let Some(k) = m
+            .normals
+            .iter()
+            .position(|n| !(n.is_finite() && (n.length() - 1.0).abs() <= UNIT_TOLERANCE))
+        {
+            return fail(format!(
+                "vertex normal {k} is not a finite unit vector: {}",
+                m.normals[k]
+            ));
+        }
+        let n = m.positions.len();
+        if let Some(t) = m
+            .triangles
+            .iter()
+            .position(|t| t.iter().any(|&v| v as usize >= n))
+        {
+            return fail(format!(
+                "triangle {t} {:?} names a vertex past the {n} positions",
+                m.triangles[t]
+            ));
+        }
+        let has_area = m.triangles.iter().any(|t| {
+            let [a, b, c] = t.map(|v| m.positions[v as usize]);
+            (b - a).cross(c - a).length_squared() > 0.0
+        });
+        if !has_area {
+            return fail(format!(
+                "the mesh has no triangle with non-zero area (all {} repeat a vertex or are \
+                 collinear)",
+                m.triangles.len()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Per pixel, from per-G-buffer-sample subsurface values: the subsurface image, the total
