@@ -409,7 +409,11 @@ fn spread3(src: &[f32], dst: &mut [f32]) {
         let d: &mut [f32; 24] = d.try_into().expect("24 values");
         *d = std::array::from_fn(|i| s[i / 3]);
     }
-    for (d, &s) in blocks.into_remainder().chunks_exact_mut(3).zip(sources.remainder()) {
+    for (d, &s) in blocks
+        .into_remainder()
+        .chunks_exact_mut(3)
+        .zip(sources.remainder())
+    {
         d.fill(s);
     }
 }
