@@ -153,6 +153,8 @@ fn fuzz_main(args: FuzzArgs) -> ExitCode {
 }
 
 fn main() -> ExitCode {
+    // Ctrl-C / SIGTERM: delete the temporaries of writes in flight, exit 130.
+    sss_cli::install_interrupt_handler();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

@@ -74,6 +74,41 @@ pub fn panic_message(info: &std::panic::PanicHookInfo<'_>) -> String {
     format!("{}{at}", payload.replace('\n', " "))
 }
 
+/// The exit status after Ctrl-C or SIGTERM (128 + SIGINT, the shell convention).
+pub const INTERRUPTED_STATUS: i32 = 130;
+
+/// The line printed on stderr when an interrupt removed `n` temporary files.
+pub fn interrupted_message(n: usize) -> String {
+    format!(
+        "interrupted: removed {n} temporary file{}",
+        if n == 1 { "" } else { "s" }
+    )
+}
+
+/// Installs the Ctrl-C / SIGTERM / SIGHUP handler of a binary (`sss`, `xtask`): it deletes
+/// the temporary files of writes in flight ([`sss_util::remove_temporaries`]), prints
+/// [`interrupted_message`] and exits with [`INTERRUPTED_STATUS`]. Every output is written
+/// through a temporary file and a rename, so an interrupted run leaves neither a partial
+/// output nor a stray temporary file. Only binaries call this, once, before any work; a
+/// second call (or a handler already installed by someone else) is a no-op.
+pub fn install_interrupt_handler() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // Without a handler (setting it failed) the default action, termination, remains.
+        let _ = ctrlc::set_handler(|| {
+            let n = sss_util::remove_temporaries();
+            // Start on a fresh line when a progress bar occupies the current one.
+            let fresh = if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+                "\n"
+            } else {
+                ""
+            };
+            eprintln!("{fresh}{}", interrupted_message(n));
+            std::process::exit(INTERRUPTED_STATUS);
+        });
+    });
+}
+
 /// Subsurface-scattering toolkit: BSSRDF profiles and measured materials.
 #[derive(Debug, Parser)]
 #[command(name = "sss", version, about)]

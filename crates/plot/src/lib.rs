@@ -293,12 +293,13 @@ pub fn panel_plot(
 /// long computation whose result is to be plotted.
 pub fn check_writable(path: &Path) -> Result<(), PlotError> {
     PlotFormat::from_path(path)?;
-    let tmp = sss_util::temp_path(path);
-    std::fs::File::create(&tmp).map_err(|e| PlotError::Draw {
+    // Registered, so an interrupt between the create and the remove deletes it too.
+    let tmp = sss_util::Temporary::register(sss_util::temp_path(path));
+    std::fs::File::create(tmp.path()).map_err(|e| PlotError::Draw {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    let _ = std::fs::remove_file(&tmp);
+    let _ = std::fs::remove_file(tmp.path());
     Ok(())
 }
 

@@ -10,6 +10,10 @@
 //! - [`write_atomic`] and [`write_atomic_with`]: write to a temporary file in the destination's
 //!   directory, then rename it into place. A reader never sees a half-written file and a failed
 //!   write leaves nothing behind.
+//! - [`remove_temporaries`]: every temporary file of a write in flight is recorded in a
+//!   process-wide registry ([`Temporary`]); a binary's Ctrl-C / SIGTERM handler calls this to
+//!   delete them before it exits, so an interrupted run leaves no stray temporaries either.
+//!   This crate installs no signal handler itself.
 //!
 //! ```
 //! use sss_util::{splitmix64, write_atomic};
@@ -29,6 +33,8 @@
 
 use std::io;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The SplitMix64 golden-ratio increment, ⌊2⁶⁴/φ⌋ (odd).
 pub const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
@@ -49,9 +55,72 @@ pub fn splitmix64(z: u64) -> u64 {
     splitmix64_mix(z.wrapping_add(GOLDEN_GAMMA))
 }
 
-/// The temporary path used for `path`: `.<name>.<pid>.tmp.<ext>` in the same directory (so the
-/// rename is atomic) with the same extension (encoders that pick a format by extension still
-/// work).
+/// Temporary files of writes in flight, in registration order.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Makes every [`temp_path`] of this process distinct.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    // A panic while the lock was held cannot leave the list inconsistent (every operation is
+    // a single push, remove or drain), so a poisoned lock is still usable.
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A temporary file path registered for [`remove_temporaries`] while this value lives.
+/// Registering happens before the file is created and unregistering when the value is
+/// dropped (after the rename, or after the failed write removed the file).
+#[derive(Debug)]
+pub struct Temporary {
+    path: PathBuf,
+}
+
+impl Temporary {
+    /// Registers `path` as a live temporary file (the file need not exist yet).
+    pub fn register(path: PathBuf) -> Self {
+        live().push(path.clone());
+        Temporary { path }
+    }
+
+    /// The registered path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        let mut list = live();
+        if let Some(i) = list.iter().rposition(|p| *p == self.path) {
+            list.remove(i);
+        }
+    }
+}
+
+/// The temporary files registered right now (writes in flight), oldest first.
+pub fn live_temporaries() -> Vec<PathBuf> {
+    live().clone()
+}
+
+/// Deletes every registered temporary file and forgets them; returns how many files were
+/// actually deleted (a registered path whose file was not created yet counts for nothing).
+///
+/// Meant for a Ctrl-C / SIGTERM handler that exits right after. A write in flight then finds
+/// its temporary file gone and its rename fails, so no partial output is renamed into place;
+/// the one remaining window is a writer that registered its path but creates the file between
+/// this call and the process exit (microseconds).
+pub fn remove_temporaries() -> usize {
+    let paths: Vec<PathBuf> = live().drain(..).collect();
+    paths
+        .iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .count()
+}
+
+/// The temporary path used for `path`: `.<name>.<pid>-<n>.tmp.<ext>` in the same directory
+/// (so the rename is atomic) with the same extension (encoders that pick a format by
+/// extension still work). `n` counts calls in this process, so two writes of one destination
+/// at once (from two threads) never share a temporary file.
 pub fn temp_path(path: &Path) -> PathBuf {
     let name = path
         .file_name()
@@ -61,7 +130,8 @@ pub fn temp_path(path: &Path) -> PathBuf {
         .extension()
         .map(|e| e.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let tmp = format!(".{name}.{}.tmp.{ext}", std::process::id());
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let tmp = format!(".{name}.{}-{n}.tmp.{ext}", std::process::id());
     match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.join(tmp),
         _ => PathBuf::from(tmp),
@@ -71,18 +141,20 @@ pub fn temp_path(path: &Path) -> PathBuf {
 /// Calls `write` with a temporary path next to `path`, then renames the temporary file onto
 /// `path`. When `write` fails, or the rename does, the temporary file is removed and the error
 /// returned; `path` is then untouched. `rename_err` turns the rename's I/O error into `E`.
+/// The temporary path is registered (see [`Temporary`], [`remove_temporaries`]) from before
+/// `write` is called until the rename or the clean-up is done.
 pub fn write_atomic_with<E>(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), E>,
     rename_err: impl FnOnce(io::Error) -> E,
 ) -> Result<(), E> {
-    let tmp = temp_path(path);
-    if let Err(e) = write(&tmp) {
-        let _ = std::fs::remove_file(&tmp);
+    let tmp = Temporary::register(temp_path(path));
+    if let Err(e) = write(tmp.path()) {
+        let _ = std::fs::remove_file(tmp.path());
         return Err(e);
     }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
+    std::fs::rename(tmp.path(), path).map_err(|e| {
+        let _ = std::fs::remove_file(tmp.path());
         rename_err(e)
     })
 }
@@ -122,6 +194,14 @@ mod tests {
         assert_ne!(splitmix64_mix(1), 1);
     }
 
+    /// The registry is process-wide and `remove_temporaries` would delete another test's
+    /// temporary in flight, so every test that writes files runs under this lock.
+    static SERIAL: Mutex<()> = Mutex::new(());
+
+    fn serial() -> std::sync::MutexGuard<'static, ()> {
+        SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
     fn scratch(name: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("sss-util-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
@@ -131,6 +211,7 @@ mod tests {
 
     #[test]
     fn atomic_write_replaces_and_leaves_no_temporary() {
+        let _serial = serial();
         let d = scratch("replace");
         let p = d.join("a.csv");
         std::fs::write(&p, "old").unwrap();
@@ -143,6 +224,7 @@ mod tests {
 
     #[test]
     fn failed_write_keeps_the_old_file_and_removes_the_temporary() {
+        let _serial = serial();
         let d = scratch("fail");
         let p = d.join("b.exr");
         std::fs::write(&p, "old").unwrap();
@@ -175,8 +257,113 @@ mod tests {
         assert!(bare.parent().is_none_or(|p| p.as_os_str().is_empty()));
     }
 
+    /// Tests share the process-wide registry; they look only at their own paths.
+    fn registered(p: &Path) -> usize {
+        live_temporaries().iter().filter(|q| *q == p).count()
+    }
+
+    #[test]
+    fn temporary_is_registered_during_a_successful_write_and_forgotten_after() {
+        let _serial = serial();
+        let d = scratch("registry-ok");
+        let p = d.join("c.txt");
+        let mut seen = None;
+        write_atomic_with(
+            &p,
+            |tmp| {
+                seen = Some((tmp.to_path_buf(), registered(tmp)));
+                std::fs::write(tmp, "x")
+            },
+            |e| e,
+        )
+        .unwrap();
+        let (tmp, count) = seen.unwrap();
+        assert_eq!(count, 1, "registered once while writing");
+        assert_eq!(registered(&tmp), 0, "forgotten after the rename");
+        assert!(!tmp.exists());
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "x");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn temporary_is_forgotten_after_a_failed_write() {
+        let _serial = serial();
+        let d = scratch("registry-fail");
+        let p = d.join("d.txt");
+        let mut seen = None;
+        let r: Result<(), String> = write_atomic_with(
+            &p,
+            |tmp| {
+                std::fs::write(tmp, "partial").unwrap();
+                seen = Some((tmp.to_path_buf(), registered(tmp)));
+                Err("failed".into())
+            },
+            |e| e.to_string(),
+        );
+        assert!(r.is_err());
+        let (tmp, count) = seen.unwrap();
+        assert_eq!(count, 1);
+        assert_eq!(registered(&tmp), 0);
+        assert!(!tmp.exists() && !p.exists());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn remove_temporaries_deletes_registered_files_only() {
+        let _serial = serial();
+        let d = scratch("registry-remove");
+        let a = Temporary::register(d.join(".a.tmp"));
+        let b = Temporary::register(d.join(".b.tmp"));
+        let never_created = Temporary::register(d.join(".c.tmp"));
+        std::fs::write(a.path(), "a").unwrap();
+        std::fs::write(b.path(), "b").unwrap();
+        let keep = d.join("keep.txt");
+        std::fs::write(&keep, "k").unwrap();
+        // Only this test touches the registry now (`serial`): exactly our two files.
+        assert_eq!(remove_temporaries(), 2);
+        assert!(!a.path().exists() && !b.path().exists());
+        assert!(keep.exists(), "unregistered files stay");
+        assert_eq!(registered(a.path()) + registered(never_created.path()), 0);
+        // Dropping after the registry was emptied is harmless.
+        drop((a, b, never_created));
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn temp_paths_of_one_destination_are_distinct() {
+        let _serial = serial();
+        let p = Path::new("dir/same.exr");
+        let names: std::collections::HashSet<PathBuf> = (0..100).map(|_| temp_path(p)).collect();
+        assert_eq!(names.len(), 100);
+        // Concurrent writes of one destination both succeed, and no temporary is left.
+        let d = scratch("concurrent");
+        let dest = d.join("same.txt");
+        std::thread::scope(|s| {
+            for k in 0..4 {
+                let dest = &dest;
+                s.spawn(move || {
+                    write_atomic_with(
+                        dest,
+                        |tmp| {
+                            std::fs::write(tmp, format!("{k}"))?;
+                            std::thread::sleep(std::time::Duration::from_millis(20));
+                            Ok(())
+                        },
+                        |e| e,
+                    )
+                    .unwrap()
+                });
+            }
+        });
+        let text = std::fs::read_to_string(&dest).unwrap();
+        assert!(["0", "1", "2", "3"].contains(&text.as_str()), "{text}");
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
     #[test]
     fn unwritable_destination_is_an_error_not_a_panic() {
+        let _serial = serial();
         let p = Path::new("/nonexistent-dir-sss-util/x.txt");
         assert!(write_atomic(p, b"x").is_err());
     }

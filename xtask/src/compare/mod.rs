@@ -10,6 +10,7 @@
 //! Everything random is seeded ([`Config::seed`]), so error figures are reproducible; only
 //! the timings vary from run to run.
 
+mod checked;
 mod kernels;
 mod metrics;
 mod output;

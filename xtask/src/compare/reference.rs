@@ -9,9 +9,10 @@
 //! Cache files live in `<out>/cache/` and are named by everything that determines their
 //! content: preset, channel, photons, seed, bins, r_max (shortest round-trip notation) and
 //! [`CACHE_VERSION`]. Numbers are stored in round-trip notation, so a cached reference is
-//! bit-identical to a fresh one.
+//! bit-identical to a fresh one. Each file has a length-and-checksum sidecar
+//! ([`super::checked`]); a file that fails the check is reported and recomputed.
 
-use super::output::write_atomic;
+use super::checked::{self, Entry};
 use super::{Config, Error};
 use sss_bssrdf::monte_carlo::{self, McConfig};
 use sss_bssrdf::presets::Preset;
@@ -24,7 +25,7 @@ use std::time::Instant;
 pub const R_MAX_ENERGY: f64 = 0.99;
 
 /// Bump when the cache file layout (or the meaning of its key) changes.
-pub const CACHE_VERSION: u32 = 2;
+pub const CACHE_VERSION: u32 = 3;
 
 /// Channel names used in file names, CSV and the report.
 pub const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
@@ -231,6 +232,21 @@ fn deserialize(text: &str, key: &str, cfg: &McConfig) -> Option<ChannelReference
     })
 }
 
+/// A cached channel reference: `Ok(None)` when there is none, `Err(reason)` when the file
+/// must not be trusted (it fails its checksum, or does not parse as the reference of `key`).
+fn load_cached(path: &Path, key: &str, cfg: &McConfig) -> Result<Option<ChannelReference>, String> {
+    match checked::check(path) {
+        Entry::Missing => Ok(None),
+        Entry::Corrupt(reason) => Err(reason),
+        Entry::Good(bytes) => {
+            let text = String::from_utf8(bytes).map_err(|_| "not UTF-8 text".to_string())?;
+            deserialize(&text, key, cfg)
+                .map(Some)
+                .ok_or_else(|| "malformed or for other settings".into())
+        }
+    }
+}
+
 /// Loads or computes the references of every preset of `config`. `log` receives one line
 /// per channel; `on_photons(done, total)` reports simulation progress.
 pub fn load_or_compute(
@@ -259,9 +275,13 @@ pub fn load_or_compute(
             let cached = if config.fresh {
                 None
             } else {
-                std::fs::read_to_string(&path)
-                    .ok()
-                    .and_then(|t| deserialize(&t, &key, &cfg))
+                load_cached(&path, &key, &cfg).unwrap_or_else(|reason| {
+                    log(&format!(
+                        "{} {}: cached Monte Carlo reference is corrupt ({reason}), recomputing",
+                        preset.name, channel_name
+                    ));
+                    None
+                })
             };
             let reference = match cached {
                 Some(r) => {
@@ -293,7 +313,7 @@ pub fn load_or_compute(
                         capped: mc.capped,
                         seconds: Some(seconds),
                     };
-                    write_atomic(&path, serialize(&key, &r).as_bytes())?;
+                    checked::write_entry(&path, serialize(&key, &r).as_bytes())?;
                     log(&format!(
                         "{} {}: Monte Carlo reference, {} photons in {seconds:.1} s (r_max {:.3} mm)",
                         preset.name, channel_name, cfg.photons, cfg.r_max
@@ -354,5 +374,69 @@ mod tests {
         );
         assert!((parsed.total_of(McPart::Multiple) - 0.5).abs() < 1e-15);
         assert_eq!(parsed.total_of(McPart::All), 0.7);
+    }
+
+    #[test]
+    fn cached_file_is_checked_before_it_is_trusted() {
+        use crate::compare::checked::{sum_path, tests as t};
+        let cfg = McConfig {
+            photons: 10,
+            seed: 3,
+            r_max: 2.0,
+            bins: 2,
+            channels: [true, false, false],
+        };
+        let r = ChannelReference {
+            r_max: cfg.r_max,
+            edges: vec![0.0, 1.0, 2.0],
+            rd: vec![0.25, 0.125],
+            se: vec![0.01, 0.02],
+            rd_single: vec![0.0625, 0.0],
+            total: 0.5,
+            total_se: 0.001,
+            total_single: 0.1,
+            capped: 0,
+            seconds: None,
+        };
+        let key = key_line("skin1", 0, &cfg);
+        let d = t::scratch("mc");
+        let p = cache_path(&d, "skin1", 0, &cfg);
+        assert_eq!(load_cached(&p, &key, &cfg), Ok(None));
+        checked::write_entry(&p, serialize(&key, &r).as_bytes()).unwrap();
+        assert_eq!(load_cached(&p, &key, &cfg), Ok(Some(r.clone())));
+
+        // A changed digit still parses (2.5e-1 -> 3.5e-1), so only the checksum catches it.
+        let text = serialize(&key, &r);
+        let at = text.find("2.5e-1").unwrap();
+        t::flip_byte(&p, at); // '2' ^ 1 = '3'
+        let altered = std::fs::read_to_string(&p).unwrap();
+        assert!(deserialize(&altered, &key, &cfg).is_some_and(|a| a.rd[0] == 0.35));
+        assert_eq!(
+            load_cached(&p, &key, &cfg),
+            Err("checksum mismatch".to_string())
+        );
+
+        // Cut after the first bin's line: the parser alone would reject it too (1 bin of 2),
+        // but the length check names the cause.
+        checked::write_entry(&p, text.as_bytes()).unwrap();
+        let cut = text.lines().take(5).map(|l| l.len() + 1).sum::<usize>() as u64;
+        t::truncate(&p, cut);
+        assert_eq!(
+            load_cached(&p, &key, &cfg),
+            Err(format!("{cut} bytes, {} expected", text.len()))
+        );
+
+        checked::write_entry(&p, text.as_bytes()).unwrap();
+        std::fs::remove_file(sum_path(&p)).unwrap();
+        assert_eq!(
+            load_cached(&p, &key, &cfg),
+            Err("no checksum file".to_string())
+        );
+
+        // A sealed file for other settings is not taken either.
+        checked::write_entry(&p, text.as_bytes()).unwrap();
+        let other = key_line("skin2", 0, &cfg);
+        assert!(load_cached(&p, &other, &cfg).is_err());
+        std::fs::remove_dir_all(&d).unwrap();
     }
 }

@@ -353,6 +353,8 @@ pub fn run_supervised(config: &Config, args: &[String]) -> Result<bool, String> 
         Some(0) => Ok(false),
         Some(CRASH_STATUS) => Ok(true),
         Some(2) => Err("the fuzz worker failed (see its error above)".into()),
+        // Ctrl-C reached the worker too; not a crash of the input it was running.
+        Some(sss_cli::INTERRUPTED_STATUS) => Err("the fuzz worker was interrupted".into()),
         _ => {
             let what = std::fs::read_to_string(&txt).unwrap_or_default();
             let mut parts = what.split_whitespace();

@@ -93,12 +93,13 @@ pub fn check_output(path: &Path, ext: &str) -> Result<(), Error> {
             path.display()
         )));
     }
-    let tmp = path.with_extension(format!("{ext}.{}.probe", std::process::id()));
-    std::fs::File::create(&tmp).map_err(|source| Error::Io {
+    // A registered temporary name, so an interrupt right here leaves nothing behind either.
+    let tmp = sss_util::Temporary::register(sss_util::temp_path(path));
+    std::fs::File::create(tmp.path()).map_err(|source| Error::Io {
         what: format!("cannot write {}", path.display()),
         source,
     })?;
-    let _ = std::fs::remove_file(&tmp);
+    let _ = std::fs::remove_file(tmp.path());
     Ok(())
 }
 
