@@ -78,6 +78,25 @@ pub const ROULETTE_SURVIVAL: f64 = 0.1;
 /// Largest accepted number of radial bins (keeps the per-chunk tallies bounded in memory).
 pub const MAX_BINS: usize = 1 << 20;
 
+/// The estimated peak bytes of a simulation with `bins` radial bins on `threads` worker
+/// threads (saturating, never overflowing). It does not depend on the photon count: photons
+/// are traced and tallied in batches, so they cost time only.
+///
+/// Counted from the allocations of [`simulate`]: per chunk a tally of 3 bin arrays, up to
+/// 8 × `threads` chunk tallies held per batch, and per running chunk a scratch of 2 bin arrays;
+/// the 3 channel tallies (3 arrays each); the result's `rd`, `se`, `rd_single` (3 channels
+/// each), bin edges and areas (11 arrays); every array is `bins` f64.
+pub fn memory_bytes(bins: usize, threads: usize) -> u64 {
+    let threads = threads.max(1) as u64;
+    let arrays = (8 * threads)
+        .saturating_mul(3)
+        .saturating_add(threads.saturating_mul(2))
+        .saturating_add(9 + 9 + 2);
+    arrays
+        .saturating_mul(bins as u64)
+        .saturating_mul(std::mem::size_of::<f64>() as u64)
+}
+
 /// What to simulate. Plain data; checked by [`simulate`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct McConfig {
@@ -464,17 +483,23 @@ pub(crate) fn simulate_impl(
     });
 
     let n_chunks = cfg.photons.div_ceil(CHUNK_PHOTONS);
-    let items: Vec<(usize, u64)> = (0..3)
-        .filter(|&ch| cfg.channels[ch])
-        .flat_map(|ch| (0..n_chunks).map(move |k| (ch, k)))
-        .collect();
+    // The (channel, chunk) work items are generated one batch at a time, never all at once:
+    // memory does not grow with the photon count, only time does.
+    let active: Vec<usize> = (0..3).filter(|&ch| cfg.channels[ch]).collect();
+    let n_items = active.len() as u64 * n_chunks;
 
     let mut tallies: [Tally; 3] = std::array::from_fn(|_| Tally::new(bins));
     let done = Mutex::new(0_u64);
     // Batches bound the memory held in per-chunk tallies; their size does not affect the
     // result because tallies are always summed in chunk order.
-    let batch = 8 * rayon::current_num_threads().max(1);
-    for group in items.chunks(batch) {
+    let batch = 8 * rayon::current_num_threads().max(1) as u64;
+    let mut start = 0_u64;
+    while start < n_items {
+        let end = start.saturating_add(batch).min(n_items);
+        let group: Vec<(usize, u64)> = (start..end)
+            .map(|i| (active[(i / n_chunks) as usize], i % n_chunks))
+            .collect();
+        start = end;
         let results: Vec<Tally> = group
             .par_iter()
             .map(|&(ch, k)| {
@@ -537,6 +562,22 @@ pub(crate) fn simulate_impl(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn memory_estimate_covers_the_tallies_and_saturates() {
+        // The result alone holds rd, se, rd_single for 3 channels (9 arrays of bins f64) and
+        // each of the 8 chunk tallies per thread 3 more arrays.
+        let bins = 1000;
+        for threads in [1, 2, 16] {
+            let b = memory_bytes(bins, threads);
+            assert!(b >= (9 + 24 * threads as u64) * 8 * bins as u64, "{b}");
+            // Linear in bins.
+            assert_eq!(memory_bytes(2 * bins, threads), 2 * b);
+        }
+        // 0 threads counts as 1; absurd sizes saturate instead of overflowing.
+        assert_eq!(memory_bytes(bins, 0), memory_bytes(bins, 1));
+        assert_eq!(memory_bytes(usize::MAX, 64), u64::MAX);
+    }
     use crate::quadrature::{gauss_legendre, integrate};
 
     /// Event cap of the albedo-1 tests: P(a walk survives n collisions) ~ 1.7/√n, so this

@@ -150,6 +150,49 @@ pub fn radii(r_max: f64, steps: usize, log: bool) -> Vec<f64> {
         .collect()
 }
 
+/// Bytes of one CSV row at most: 7 numbers in shortest round-trip scientific notation (at most
+/// 24 characters each, e.g. `-1.2345678901234567e-308`) and their separators.
+const CSV_ROW_BYTES: u64 = 7 * 25;
+
+/// The estimated peak bytes of evaluating and printing `req` (saturating): per row the radius,
+/// the [`ProfileRow`], the CSV text and a plot point per channel; for Monte Carlo also the
+/// simulation's bin arrays ([`monte_carlo::memory_bytes`] on the current rayon threads). The
+/// photon count costs time, not memory.
+pub fn memory_bytes(req: &ProfileRequest) -> u64 {
+    let per_row = (std::mem::size_of::<f64>() + std::mem::size_of::<ProfileRow>()) as u64
+        + CSV_ROW_BYTES
+        + 3 * 2 * std::mem::size_of::<f64>() as u64;
+    let rows = (req.steps as u64).saturating_mul(per_row);
+    match req.model {
+        ProfileModel::MonteCarlo => rows.saturating_add(monte_carlo::memory_bytes(
+            req.steps,
+            rayon::current_num_threads(),
+        )),
+        _ => rows,
+    }
+}
+
+/// Fails, naming `--steps`, the bytes needed and the budget, when `req` is estimated
+/// ([`memory_bytes`]) to need more than `budget` bytes. Nothing is allocated before.
+pub fn check_budget(req: &ProfileRequest, budget: u64) -> Result<(), Error> {
+    let needed = memory_bytes(req);
+    if needed > budget {
+        return Err(Error::Input(format!(
+            "--steps {} ({}) needs about {needed} bytes ({}), over the memory budget of \
+             {budget} bytes ({}); lower --steps or raise --max-memory",
+            req.steps,
+            if req.model == ProfileModel::MonteCarlo {
+                "Monte Carlo bins"
+            } else {
+                "rows"
+            },
+            sss_render::budget::human(needed),
+            sss_render::budget::human(budget)
+        )));
+    }
+    Ok(())
+}
+
 fn check_request(req: &ProfileRequest) -> Result<(), Error> {
     if !(req.r_max.is_finite() && req.r_max > 0.0) {
         return Err(Error::Input(format!(
@@ -332,6 +375,53 @@ impl ProfileTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn absurd_steps_are_refused_by_the_budget_before_any_allocation() {
+        for model in [ProfileModel::Pbd, ProfileModel::MonteCarlo] {
+            let req = ProfileRequest {
+                steps: 1_000_000_000_000_000,
+                ..ProfileRequest::new(model, MediumSpec::Preset("skin1".into()), 5.0)
+            };
+            // 10^15 rows of at least 4 f64 each is 3.2e16 bytes, over any budget up to 2^54.
+            let budget = 1u64 << 54;
+            assert!(memory_bytes(&req) >= 32 * req.steps as u64);
+            let msg = check_budget(&req, budget).unwrap_err().to_string();
+            assert!(msg.contains("--steps 1000000000000000"), "{msg}");
+            assert!(msg.contains(&format!("budget of {budget} bytes")), "{msg}");
+            assert!(
+                msg.contains("needs about ") && msg.contains("--max-memory"),
+                "{msg}"
+            );
+        }
+    }
+
+    #[test]
+    fn budget_counts_rows_and_monte_carlo_bins() {
+        let skin = || MediumSpec::Preset("skin1".into());
+        // 10^4 rows hold at least 10^4 × 4 f64 (radius and R_d) = 320 kB and, with the CSV
+        // text of ≥ 4 numbers of ≥ 5 characters each, less than 10 MB.
+        let req = ProfileRequest {
+            steps: 10_000,
+            ..ProfileRequest::new(ProfileModel::Pbd, skin(), 5.0)
+        };
+        let b = memory_bytes(&req);
+        assert!((320_000..10_000_000).contains(&b), "{b}");
+        assert!(check_budget(&req, 10_000_000).is_ok());
+        assert!(check_budget(&req, 320_000).is_err());
+        // Monte Carlo also holds ≥ 3 channels × 3 arrays (sum, squares, single) of bins.
+        let mc = ProfileRequest {
+            model: ProfileModel::MonteCarlo,
+            ..req
+        };
+        assert!(memory_bytes(&mc) >= b + 9 * 8 * 10_000);
+        // Photons do not change the estimate: they are not stored.
+        let many = ProfileRequest {
+            photons: u64::MAX,
+            ..mc.clone()
+        };
+        assert_eq!(memory_bytes(&many), memory_bytes(&mc));
+    }
 
     #[test]
     fn radii_linear_and_log() {

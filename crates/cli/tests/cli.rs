@@ -1028,3 +1028,58 @@ fn render_warns_when_a_cap_binds_and_for_foreign_flags() {
         .collect();
     assert_eq!(names.len(), 1, "only the scene file: {names:?}");
 }
+
+#[test]
+fn profile_over_the_memory_budget_is_one_error_line_and_no_plot() {
+    let dir = std::env::temp_dir().join(format!("sss-profile-budget-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let plot = dir.join("p.png");
+    // 10^15 steps would abort if allocated; the default budget refuses them first.
+    for (model, steps, budget) in [
+        ("pbd", "1000000000000000", None),
+        ("monte-carlo", "1000000000000000", None),
+        // Within the hard limits, but 10^5 rows need more than 1 MiB.
+        ("burley", "100000", Some("1M")),
+        ("monte-carlo", "100000", Some("1M")),
+    ] {
+        let mut args = vec![
+            "profile", "--model", model, "--preset", "skin1", "--r-max", "4", "--steps", steps,
+            "--plot",
+        ];
+        args.push(plot.to_str().unwrap());
+        if let Some(b) = budget {
+            args.extend(["--max-memory", b]);
+        }
+        let o = sss(&args);
+        assert_eq!(o.status.code(), Some(2), "{model} {steps}");
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with("error: "), "{err}");
+        assert!(err.contains(&format!("--steps {steps}")), "{err}");
+        assert!(
+            err.contains("needs about ") && err.contains("memory budget of "),
+            "{err}"
+        );
+        if budget.is_some() {
+            assert!(err.contains("budget of 1048576 bytes"), "{err}");
+        }
+        assert!(stdout(&o).is_empty());
+        assert!(!plot.exists());
+    }
+    // The same request under a sufficient budget succeeds.
+    let o = sss(&[
+        "profile",
+        "--model",
+        "burley",
+        "--preset",
+        "skin1",
+        "--r-max",
+        "4",
+        "--steps",
+        "100000",
+        "--max-memory",
+        "1G",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -3,7 +3,7 @@
 
 use crate::args::MediumArgs;
 use crate::plot_error;
-use crate::profile_table::{ProfileModel, ProfileRequest, compute};
+use crate::profile_table::{ProfileModel, ProfileRequest, check_budget, compute};
 use clap::Args;
 use sss_render::Error;
 use std::path::PathBuf;
@@ -29,12 +29,18 @@ pub struct ProfileArgs {
     /// Also draw the profile to this file (.png or .svg).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// Monte Carlo photons per channel.
+    /// Monte Carlo photons per channel. They cost time only, not memory: photons are traced
+    /// and tallied in batches, never stored.
     #[arg(long, default_value_t = 1_000_000)]
     pub photons: u64,
     /// Monte Carlo seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Memory budget (bytes, or with a suffix: 512M, 8G); a profile whose rows (or Monte Carlo
+    /// bins) are estimated to need more is refused before anything is allocated. Default: half
+    /// the physical memory.
+    #[arg(long, value_name = "BYTES", value_parser = sss_render::budget::parse_bytes)]
+    pub max_memory: Option<u64>,
 }
 
 impl ProfileArgs {
@@ -57,6 +63,11 @@ impl ProfileArgs {
 /// Runs `sss profile`: the CSV bytes for stdout (after the plot, if any, is written).
 pub fn run(args: &ProfileArgs) -> Result<Vec<u8>, Error> {
     let req = args.request()?;
+    check_budget(
+        &req,
+        args.max_memory
+            .unwrap_or_else(sss_render::budget::default_budget),
+    )?;
     if let Some(path) = &args.plot {
         // Fail on a bad extension or directory before a long computation.
         sss_plot::check_writable(path).map_err(plot_error)?;
