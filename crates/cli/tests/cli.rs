@@ -1083,3 +1083,72 @@ fn profile_over_the_memory_budget_is_one_error_line_and_no_plot() {
     assert!(o.status.success(), "{}", stderr(&o));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn filter_and_diff_refuse_an_exr_whose_header_exceeds_the_budget() {
+    let dir = std::env::temp_dir().join(format!("sss-exr-budget-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("huge.exr");
+    let px = vec![[1.0f64; 3]; 4];
+    sss_render::image::write_exr(&path, 2, 2, &[("irradiance", &px), ("surface", &px)]).unwrap();
+    let small = dir.join("small.exr");
+    std::fs::copy(&path, &small).unwrap();
+    // Patch every dataWindow (name, type `box2i`, size 16, then xMin yMin xMax yMax as i32
+    // LE; OpenEXR file layout) to 0..=99999: 10¹⁰ pixels of at least 12 bytes each.
+    let mut bytes = std::fs::read(&path).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let hits: Vec<usize> = (0..bytes.len() - key.len())
+        .filter(|&i| &bytes[i..i + key.len()] == key)
+        .collect();
+    assert!(!hits.is_empty());
+    for at in hits {
+        let v = at + key.len() + 4;
+        for (i, x) in [0i32, 0, 99_999, 99_999].iter().enumerate() {
+            bytes[v + 4 * i..v + 4 * i + 4].copy_from_slice(&x.to_le_bytes());
+        }
+    }
+    std::fs::write(&path, &bytes).unwrap();
+    let out = dir.join("out.exr");
+    let (p, s, o) = (
+        path.to_str().unwrap(),
+        small.to_str().unwrap(),
+        out.to_str().unwrap(),
+    );
+    for args in [
+        vec![
+            "filter",
+            p,
+            "--preset",
+            "skin1",
+            "--units-per-mm",
+            "1",
+            "--out",
+            o,
+            "--max-memory",
+            "1G",
+        ],
+        vec!["diff", p, s, "--max-memory", "1G"],
+        vec!["diff", s, p, "--max-memory", "1G"],
+    ] {
+        let r = sss(&args);
+        assert_eq!(r.status.code(), Some(2), "{args:?}");
+        let err = stderr(&r);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with("error: "), "{err}");
+        assert!(
+            err.contains("huge.exr") && err.contains("100000x100000"),
+            "{err}"
+        );
+        assert!(err.contains("memory budget of 1073741824 bytes"), "{err}");
+        assert!(!out.exists());
+    }
+    // Two small files under a budget that holds both (2 × 2 layers × 4 px × 36 bytes = 576).
+    assert!(
+        sss(&["diff", s, s, "--layer", "surface", "--max-memory", "576"])
+            .status
+            .success()
+    );
+    let r = sss(&["diff", s, s, "--layer", "surface", "--max-memory", "575"]);
+    assert_eq!(r.status.code(), Some(2), "{}", stderr(&r));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -76,10 +76,78 @@ pub fn write_exr(
 /// Named RGB layers of an image: (layer name, pixels).
 pub type Layers = Vec<(String, Vec<Rgb>)>;
 
+/// The estimated bytes of reading the OpenEXR file at `path` with [`read_exr`], from its
+/// header alone (no pixel is read): per layer, width × height × (the bytes of one sample of
+/// every channel, as the `exr` crate holds them: 2 for f16, 4 for f32 and u32, subsampled
+/// channels counted at full size + 24 for the f64 RGB copy). Saturating, never overflowing.
+pub fn exr_bytes(path: &Path) -> Result<u64, crate::Error> {
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .map_err(|e| io_err(path, "reading the header of", e))?;
+    Ok(meta_bytes(&meta))
+}
+
+fn meta_bytes(meta: &exr::meta::MetaData) -> u64 {
+    let mut total = 0u64;
+    for header in meta.headers.iter() {
+        let pixels = (header.layer_size.0 as u64).saturating_mul(header.layer_size.1 as u64);
+        let per_pixel = header
+            .channels
+            .list
+            .iter()
+            .map(|c| c.sample_type.bytes_per_sample() as u64)
+            .sum::<u64>()
+            + std::mem::size_of::<Rgb>() as u64;
+        total = total.saturating_add(pixels.saturating_mul(per_pixel));
+    }
+    total
+}
+
+/// Fails, naming the file, its size and layers, the bytes needed and the budget, when reading
+/// the EXR files `paths` together is estimated ([`exr_bytes`]) to need more than `budget`
+/// bytes. Only the headers are read.
+pub fn check_exr_budget(paths: &[&Path], budget: u64) -> Result<(), crate::Error> {
+    let mut needed = 0u64;
+    let mut what = Vec::new();
+    for path in paths {
+        let meta = exr::meta::MetaData::read_from_file(path, false)
+            .map_err(|e| io_err(path, "reading the header of", e))?;
+        let sizes: Vec<String> = meta
+            .headers
+            .iter()
+            .map(|h| format!("{}x{}", h.layer_size.0, h.layer_size.1))
+            .collect();
+        what.push(format!(
+            "{} ({} layer(s) of {})",
+            path.display(),
+            sizes.len(),
+            sizes.join(", ")
+        ));
+        needed = needed.saturating_add(meta_bytes(&meta));
+    }
+    if needed > budget {
+        return Err(crate::Error::Input(format!(
+            "{} needs about {needed} bytes ({}) to read, over the memory budget of {budget} \
+             bytes ({}); raise --max-memory if the file is genuine",
+            what.join(" and "),
+            crate::budget::human(needed),
+            crate::budget::human(budget)
+        )));
+    }
+    Ok(())
+}
+
+/// [`read_exr_within`] with the default budget ([`crate::budget::default_budget`]).
+pub fn read_exr(path: &Path) -> Result<(u32, u32, Layers), crate::Error> {
+    read_exr_within(path, crate::budget::default_budget())
+}
+
 /// Reads every RGB layer of an OpenEXR file, with the image size (width, height). The RGB
 /// layers must all have that one size (an error names the file and the layers otherwise).
-pub fn read_exr(path: &Path) -> Result<(u32, u32, Layers), crate::Error> {
+/// A file whose header says it needs more than `budget` bytes is refused before any pixel is
+/// read ([`check_exr_budget`]).
+pub fn read_exr_within(path: &Path, budget: u64) -> Result<(u32, u32, Layers), crate::Error> {
     use exr::prelude::*;
+    check_exr_budget(&[path], budget)?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()

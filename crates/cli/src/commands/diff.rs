@@ -8,7 +8,7 @@ use clap::Args;
 use sss_bssrdf::Rgb;
 use sss_plot::write_error_map;
 use sss_render::Error;
-use sss_render::image::read_exr;
+use sss_render::image::{check_exr_budget, read_exr_within};
 use sss_render::metrics::{error_figures, mean_ratio_rgb, relative_errors};
 use std::path::{Path, PathBuf};
 
@@ -28,6 +28,10 @@ pub struct DiffArgs {
     /// Relative-error threshold for the fraction of pixels within it.
     #[arg(long, default_value_t = 0.05)]
     pub eps: f64,
+    /// Memory budget (bytes, or with a suffix: 512M, 8G); two EXRs whose headers say they need
+    /// more together are refused before any pixel is read. Default: half the physical memory.
+    #[arg(long, value_name = "BYTES", value_parser = sss_render::budget::parse_bytes)]
+    pub max_memory: Option<u64>,
 }
 
 /// Runs `sss diff`.
@@ -35,8 +39,12 @@ pub fn run(args: &DiffArgs) -> Result<String, Error> {
     if let Some(p) = &args.png {
         check_output(p, "png")?;
     }
-    let (w, h, a) = read_exr(&args.image)?;
-    let (wr, hr, b) = read_exr(&args.reference)?;
+    let budget = args
+        .max_memory
+        .unwrap_or_else(sss_render::budget::default_budget);
+    check_exr_budget(&[&args.image, &args.reference], budget)?;
+    let (w, h, a) = read_exr_within(&args.image, budget)?;
+    let (wr, hr, b) = read_exr_within(&args.reference, budget)?;
     if (w, h) != (wr, hr) {
         return Err(Error::Input(format!(
             "{} is {w}x{h} but {} is {wr}x{hr}",

@@ -11,7 +11,7 @@ use crate::profile_table::build_medium;
 use clap::Args;
 use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_render::Error;
-use sss_render::image::{auto_exposure, read_exr, write_exr, write_png};
+use sss_render::image::{auto_exposure, read_exr_within, write_exr, write_png};
 use sss_render::integrators::separable::kernel_settings;
 use sss_render::kernel_choice::{MaterialKernel, build_kernel, filter_options};
 use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
@@ -43,6 +43,11 @@ pub struct FilterArgs {
     /// Tone-mapped PNG of the exitance.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
+    /// Memory budget (bytes, or with a suffix: 512M, 8G); an input EXR whose header says it
+    /// needs more to read is refused before any pixel is read. Default: half the physical
+    /// memory.
+    #[arg(long, value_name = "BYTES", value_parser = sss_render::budget::parse_bytes)]
+    pub max_memory: Option<u64>,
 }
 
 /// Runs `sss filter`; returns a one-line summary.
@@ -60,7 +65,10 @@ pub fn run(args: &FilterArgs) -> Result<String, Error> {
     }
     let medium = build_medium(&args.medium.spec()?, args.medium.eta)?;
     let model = make_model(args.model, &medium);
-    let (w, h, layers) = read_exr(&args.input)?;
+    let budget = args
+        .max_memory
+        .unwrap_or_else(sss_render::budget::default_budget);
+    let (w, h, layers) = read_exr_within(&args.input, budget)?;
     let layer = |name: &str| -> Result<&Vec<Rgb>, Error> {
         layers.iter().find(|(n, _)| n == name).map(|(_, d)| d).ok_or_else(|| {
             Error::Input(format!("{}: no layer `{name}` (write it with `sss render --method separable --gbuffer`)", args.input.display()))
