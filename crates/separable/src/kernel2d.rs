@@ -16,6 +16,29 @@ use crate::kernel::Energy;
 use sss_bssrdf::Bssrdf;
 use sss_bssrdf::quadrature::gauss_legendre;
 
+/// Largest accepted cells per side of a 2D kernel grid: 4095² cells × 3 channels × 8 bytes
+/// ≈ 384 MiB. The grid is N² f64 per channel, so an absurd N (10⁸) is refused with an error
+/// naming N and the bytes instead of an allocation failure.
+pub const MAX_CELLS: usize = 4095;
+
+/// Bytes of the cell masses of an N × N grid (3 channels of f64; saturating).
+pub fn grid_bytes(cells: usize) -> u64 {
+    (cells as u64)
+        .saturating_mul(cells as u64)
+        .saturating_mul(3 * std::mem::size_of::<f64>() as u64)
+}
+
+fn check_cells(cells: usize) -> Result<(), SeparableError> {
+    ensure(cells <= MAX_CELLS, || {
+        format!(
+            "cells = {cells} would need {} bytes for the {cells}² grid, over the limit of \
+             {MAX_CELLS} cells per side ({} bytes)",
+            grid_bytes(cells),
+            grid_bytes(MAX_CELLS)
+        )
+    })
+}
+
 /// How to discretise a model's kernel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kernel2dSpec {
@@ -64,6 +87,7 @@ impl Kernel2d {
         ensure(spec.cells % 2 == 1 && spec.cells >= 3, || {
             format!("cells = {} must be odd and at least 3", spec.cells)
         })?;
+        check_cells(spec.cells)?;
         ensure(
             spec.energy_fraction > 0.0 && spec.energy_fraction < 1.0,
             || {
@@ -156,6 +180,7 @@ impl Kernel2d {
         density: impl Fn(f64, f64) -> Rgb,
     ) -> Result<Self, SeparableError> {
         ensure(cells % 2 == 1, || format!("cells = {cells} must be odd"))?;
+        check_cells(cells)?;
         ensure(cell_mm > 0.0 && cell_mm.is_finite(), || {
             format!("cell_mm = {cell_mm} must be positive and finite")
         })?;
@@ -253,6 +278,34 @@ impl Kernel2d {
 mod tests {
     use super::*;
     use sss_bssrdf::{Medium, ModelKind, make_model};
+
+    #[test]
+    fn absurd_grids_are_refused_before_allocation() {
+        let m = Medium::preset("skin1").unwrap();
+        let model = make_model(ModelKind::BetterDipole, &m);
+        // 10⁸ + 1 cells per side: 10¹⁶ cells × 24 bytes = 2.4·10¹⁷ bytes, would abort.
+        let n = 100_000_001;
+        let spec = Kernel2dSpec {
+            cells: n,
+            ..Default::default()
+        };
+        let e = Kernel2d::from_model(model.as_ref(), &spec)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("cells = 100000001"), "{e}");
+        assert!(e.contains("240000004800000024 bytes"), "{e}");
+        let e = Kernel2d::from_density(n, 0.1, 1, |_, _| [1.0; 3])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("240000004800000024 bytes"), "{e}");
+        assert_eq!(grid_bytes(usize::MAX), u64::MAX);
+        // Just over the limit is refused; a large grid under it is built (a constant density
+        // sums to cells² · h²).
+        assert!(Kernel2d::from_density(MAX_CELLS + 2, 1e-3, 1, |_, _| [1.0; 3]).is_err());
+        let k = Kernel2d::from_density(1001, 1e-3, 1, |_, _| [1.0; 3]).unwrap();
+        let expect = (1001.0f64 * 1e-3).powi(2);
+        assert!((k.total[0] - expect).abs() < 1e-9 * expect, "{:?}", k.total);
+    }
 
     #[test]
     fn kernel_is_symmetric_and_holds_the_requested_energy() {
