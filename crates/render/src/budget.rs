@@ -8,6 +8,9 @@
 
 use crate::Error;
 use crate::gbuffer::GSample;
+use crate::irradiance::{IrradianceSample, IrradianceSettings};
+use crate::lights::Incident;
+use sss_bssrdf::ModelKind;
 use sss_scene::Scene;
 
 /// Used when the physical memory cannot be read (not Linux, or no `/proc/meminfo`).
@@ -113,6 +116,97 @@ pub fn check_frame(scene: &Scene, budget: u64) -> Result<(), Error> {
             "{what} needs about {needed} bytes ({}), over the memory budget of {budget} bytes \
              ({}); lower the resolution or pixel_samples, or raise --max-memory",
             human(needed),
+            human(budget)
+        )));
+    }
+    Ok(())
+}
+
+/// Bytes per irradiance sample at the peak of [`crate::irradiance::compute`]: the lit sample
+/// with its (possibly empty) packet list, the sample again in the object's array, the
+/// blue-noise point it came from, and ~64 bytes of the blue-noise placement's grid and
+/// candidates (its memory is proportional to the sample count).
+pub const BYTES_PER_IRRADIANCE_SAMPLE: u64 = 2 * std::mem::size_of::<IrradianceSample>() as u64
+    + std::mem::size_of::<Vec<Incident>>() as u64
+    + std::mem::size_of::<sss_hierarchy::SurfaceSample>() as u64
+    + 64;
+
+/// Upper bound on the number of points at least `spacing` apart on a surface of `area`: disks
+/// of radius spacing/2 around them do not overlap, and no packing of equal disks in the plane
+/// is denser than the hexagonal one, π/(2√3) (Thue's theorem; Fejes Tóth 1940), so
+/// N ≤ 2·area / (√3·spacing²), plus one. `None` when the spacing is not positive and finite
+/// (then only the cap bounds the count).
+pub fn packing_bound(area: f64, spacing: f64) -> Option<u64> {
+    if !(spacing.is_finite() && spacing > 0.0 && area.is_finite() && area >= 0.0) {
+        return None;
+    }
+    let n = 2.0 * area / (3f64.sqrt() * spacing * spacing);
+    // Saturating: f64 → u64 casts clamp, and an absurd count is what the budget is for.
+    Some((n.ceil() as u64).saturating_add(1))
+}
+
+/// Per translucent object of `scene`: its index, the estimated irradiance-sample count
+/// min(`max_samples`, [`packing_bound`] of its area at the requested spacing) and the bytes
+/// ([`BYTES_PER_IRRADIANCE_SAMPLE`] each, plus for the directional dipole up to
+/// `light_samples` incident packets per light per sample).
+pub fn irradiance_estimate(scene: &Scene, settings: &IrradianceSettings) -> Vec<(usize, u64, u64)> {
+    (0..scene.objects.len())
+        .filter_map(|o| {
+            let mat = scene.translucent(o)?;
+            let mesh = &scene.objects[o].mesh;
+            let area: f64 = mesh
+                .triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                    0.5 * (b - a).cross(c - a).length()
+                })
+                .filter(|a| a.is_finite())
+                .sum();
+            let mfp_mm = (0..3)
+                .map(|c| 1.0 / mat.medium.sigma_t_reduced(c).max(1e-300))
+                .fold(f64::INFINITY, f64::min);
+            let spacing = settings.spacing_mfp * mfp_mm * mat.units_per_mm;
+            let cap = settings.max_samples as u64;
+            let count = packing_bound(area, spacing).map_or(cap, |n| n.min(cap));
+            let mut per = BYTES_PER_IRRADIANCE_SAMPLE;
+            if mat.model == ModelKind::DirectionalDipole {
+                let packets = (scene.lights.len() as u64)
+                    .saturating_mul(settings.light_samples.max(1) as u64);
+                per = per.saturating_add(
+                    packets.saturating_mul(std::mem::size_of::<Incident>() as u64) + 4,
+                );
+            }
+            Some((o, count, count.saturating_mul(per)))
+        })
+        .collect()
+}
+
+/// Fails, naming `--max-samples`, the spacing, the largest object's sample count, the bytes
+/// and the budget, when the irradiance samples ([`irradiance_estimate`], summed over the
+/// translucent objects) on top of the frame ([`frame_bytes`]) would need more than `budget`.
+pub fn check_irradiance(
+    scene: &Scene,
+    settings: &IrradianceSettings,
+    budget: u64,
+) -> Result<(), Error> {
+    let cam = &scene.camera;
+    let frame = frame_bytes(cam.width, cam.height, cam.pixel_samples);
+    let est = irradiance_estimate(scene, settings);
+    let samples = est.iter().fold(0u64, |a, e| a.saturating_add(e.2));
+    let needed = frame.saturating_add(samples);
+    if needed > budget {
+        let (o, count, _) = est.iter().max_by_key(|e| e.2).copied().unwrap_or_default();
+        let name = scene.objects.get(o).map_or("", |ob| ob.name.as_str());
+        return Err(Error::Input(format!(
+            "scene {}: irradiance samples (--max-samples {}, --spacing {} mean free paths; \
+             up to {count} on object `{name}`) need about {samples} bytes ({}) on top of the \
+             frame's {frame}, over the memory budget of {budget} bytes ({}); lower \
+             --max-samples, raise --spacing or raise --max-memory",
+            scene.name,
+            settings.max_samples,
+            settings.spacing_mfp,
+            human(samples),
             human(budget)
         )));
     }

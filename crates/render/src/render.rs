@@ -102,6 +102,9 @@ pub fn render(
 ) -> Result<RenderOutput, crate::Error> {
     check_scene(scene)?;
     crate::budget::check_frame(scene, settings.max_memory)?;
+    if let Some(irradiance) = integrator.irradiance_settings() {
+        crate::budget::check_irradiance(scene, &irradiance, settings.max_memory)?;
+    }
     let frame = Frame::prepare(scene, settings.seed);
     progress.start(frame.gbuffer.samples.len() as u64);
     let shaded = integrator.integrate(&frame, progress)?;

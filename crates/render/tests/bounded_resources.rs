@@ -185,8 +185,22 @@ fn frames_over_the_memory_budget_are_refused_before_allocation() {
         e.contains(&format!("budget of {} bytes", needed - 1)),
         "{e}"
     );
+    // `exact` also places irradiance samples: the budget must hold them on top of the frame.
+    let samples =
+        sss_render::budget::irradiance_estimate(&scene, &IrradianceSettings::default())[0].2;
+    let short = RenderSettings {
+        max_memory: needed + samples - 1,
+        ..RenderSettings::default()
+    };
+    let e = render(&scene, &Exact::default(), &short, &NoProgress)
+        .expect_err("samples over budget")
+        .to_string();
+    assert!(
+        e.contains("irradiance samples") && e.contains("--max-samples"),
+        "{e}"
+    );
     let enough = RenderSettings {
-        max_memory: needed,
+        max_memory: needed + samples,
         ..RenderSettings::default()
     };
     assert!(render(&scene, &Exact::default(), &enough, &NoProgress).is_ok());
@@ -208,4 +222,91 @@ fn frames_over_the_memory_budget_are_refused_before_allocation() {
         .expect_err("over budget")
         .to_string();
     assert!(e.contains("over the memory budget"), "{e}");
+}
+
+#[test]
+fn absurd_irradiance_sample_counts_are_refused_before_placement() {
+    let scene = sphere_scene(0.1);
+    // 10^15 samples at a spacing of 10⁻⁹ mean free paths: petabytes, would abort if placed.
+    let exact = Exact {
+        irradiance: IrradianceSettings {
+            spacing_mfp: 1e-9,
+            max_samples: 1_000_000_000_000_000,
+            ..IrradianceSettings::default()
+        },
+    };
+    let settings = RenderSettings {
+        max_memory: 1 << 40,
+        ..RenderSettings::default()
+    };
+    let e = render(&scene, &exact, &settings, &NoProgress)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("--max-samples 1000000000000000"), "{e}");
+    assert!(e.contains("up to 1000000000000000 on object `ball`"), "{e}");
+    assert!(
+        e.contains(&format!("budget of {} bytes", 1u64 << 40)),
+        "{e}"
+    );
+    // At least 10^15 samples × one 100-byte IrradianceSample.
+    let bytes: u64 = e
+        .split("need about ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .expect("bytes in the message");
+    assert!(bytes >= 100_000_000_000_000_000, "{e}");
+}
+
+#[test]
+fn irradiance_estimate_bounds_the_samples_placed() {
+    use sss_render::budget::{BYTES_PER_IRRADIANCE_SAMPLE, check_irradiance, irradiance_estimate};
+    let scene = sphere_scene(0.1);
+    let irr = IrradianceSettings {
+        spacing_mfp: 0.5,
+        max_samples: 1_000_000,
+        ..IrradianceSettings::default()
+    };
+    // Hexagonal packing bound on a unit sphere (area ≤ 4π for an inscribed mesh, ≥ 0.97·4π
+    // for this tessellation): 2·4π / (√3 s²), s = 0.5 · 0.1 mm / max σ'_t.
+    let s = 0.5 * 0.1 / SIGMA_T_REDUCED.iter().cloned().fold(0.0, f64::max);
+    let bound = 2.0 * 4.0 * std::f64::consts::PI / (3f64.sqrt() * s * s);
+    let est = irradiance_estimate(&scene, &irr);
+    assert_eq!(est.len(), 1);
+    let (_, count, bytes) = est[0];
+    assert!(
+        (count as f64) <= bound + 2.0 && (count as f64) >= 0.97 * bound,
+        "{count} vs {bound}"
+    );
+    assert_eq!(bytes, count * BYTES_PER_IRRADIANCE_SAMPLE);
+    // The blue-noise placement puts no more samples than the bound.
+    let exact = Exact { irradiance: irr };
+    let out = render(&scene, &exact, &RenderSettings::default(), &NoProgress).unwrap();
+    assert!(
+        out.irradiance_samples as u64 <= count,
+        "{} > {count}",
+        out.irradiance_samples
+    );
+    assert!(
+        out.irradiance_samples as u64 > count / 4,
+        "{}",
+        out.irradiance_samples
+    );
+    // The cap wins when it is lower; the budget boundary is exact.
+    let capped = IrradianceSettings {
+        max_samples: 500,
+        ..irr
+    };
+    assert_eq!(irradiance_estimate(&scene, &capped)[0].1, 500);
+    let cam = &scene.camera;
+    let frame = sss_render::budget::frame_bytes(cam.width, cam.height, cam.pixel_samples);
+    let need = frame + 500 * BYTES_PER_IRRADIANCE_SAMPLE;
+    assert!(check_irradiance(&scene, &capped, need).is_ok());
+    let e = check_irradiance(&scene, &capped, need - 1)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!("{} bytes", 500 * BYTES_PER_IRRADIANCE_SAMPLE)),
+        "{e}"
+    );
 }

@@ -103,6 +103,10 @@ impl Integrator for Exact {
         )
     }
 
+    fn irradiance_settings(&self) -> Option<IrradianceSettings> {
+        Some(self.irradiance)
+    }
+
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
         let samples = frame.irradiance_samples(&self.irradiance);
         let by_object = frame.samples_by_object(&samples);

@@ -30,6 +30,7 @@ pub use options::{MethodOptions, OptionKind, OptionSpec};
 
 use crate::Error;
 use crate::frame::Frame;
+use crate::irradiance::IrradianceSettings;
 use crate::progress::Progress;
 use sss_bssrdf::Rgb;
 
@@ -75,6 +76,11 @@ pub trait Integrator: Send + Sync {
     /// Names of the extra layers [`Shaded::layers`] will hold (empty for most methods).
     fn layer_names(&self) -> &'static [&'static str] {
         &[]
+    }
+    /// The irradiance-sample settings the method will ask the frame for, if any: their memory
+    /// is estimated before the render ([`crate::budget::check_irradiance`]).
+    fn irradiance_settings(&self) -> Option<IrradianceSettings> {
+        None
     }
     /// Shades every G-buffer sample on a visible translucent object of `frame`.
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error>;
