@@ -201,7 +201,7 @@ pub fn check_irradiance(
         return Err(Error::Input(format!(
             "scene {}: irradiance samples (--max-samples {}, --spacing {} mean free paths; \
              up to {count} on object `{name}`) need about {samples} bytes ({}) on top of the \
-             frame's {frame}, over the memory budget of {budget} bytes ({}); lower \
+             frame's {frame} bytes, over the memory budget of {budget} bytes ({}); lower \
              --max-samples, raise --spacing or raise --max-memory",
             scene.name,
             settings.max_samples,
