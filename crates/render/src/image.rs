@@ -49,7 +49,12 @@ pub fn write_exr(
             Layer::new(
                 size,
                 LayerAttributes::named(*name),
-                Encoding::FAST_LOSSLESS,
+                // Blocks in increasing order: the parallel encoder otherwise writes them in the
+                // order its threads finish, so the same image would give different files.
+                Encoding {
+                    line_order: LineOrder::Increasing,
+                    ..Encoding::FAST_LOSSLESS
+                },
                 SpecificChannels::rgb(move |Vec2(x, y): Vec2<usize>| {
                     let p = data[y * w + x];
                     (clean(p[0]), clean(p[1]), clean(p[2]))

@@ -133,7 +133,11 @@ pub fn write_layers(path: &Path, layers: &[Layer], compressed: bool) -> Result<(
             exr::prelude::Layer::new(
                 Vec2(l.w, l.h),
                 LayerAttributes::named(l.name.as_str()),
-                encoding,
+                // Blocks in increasing order, so the same mutant gives the same bytes.
+                Encoding {
+                    line_order: LineOrder::Increasing,
+                    ..encoding
+                },
                 SpecificChannels::rgb(move |Vec2(x, y): Vec2<usize>| {
                     let p = px[y * lw + x];
                     (p[0], p[1], p[2])
