@@ -2,7 +2,7 @@
 //! handling and plots.
 
 use sss_bssrdf::{Medium, ModelKind, make_model, presets::PRESETS};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 mod common;
 use common::{sss, stderr, stdout};
@@ -504,37 +504,8 @@ fn help_and_version_succeed() {
 }
 
 /// A tiny scene file for render tests: a sphere under a point light, 12×10 pixels.
-fn tiny_scene(dir: &std::path::Path) -> PathBuf {
-    let path = dir.join("tiny.toml");
-    std::fs::write(
-        &path,
-        r#"
-[camera]
-position = [0.0, 0.0, 4.0]
-target = [0.0, 0.0, 0.0]
-fov = 35.0
-resolution = [12, 10]
-
-[[lights]]
-type = "point"
-position = [2.0, 2.0, 3.0]
-intensity = 10.0
-
-[materials.skin]
-type = "translucent"
-model = "better-dipole"
-preset = "skin1"
-units_per_mm = 0.1
-
-[[objects]]
-shape = "sphere"
-radius = 1.0
-subdivisions = 3
-material = "skin"
-"#,
-    )
-    .unwrap();
-    path
+fn tiny_scene(dir: &Path) -> PathBuf {
+    common::sphere_scene(dir, "tiny.toml", 12, 10)
 }
 
 #[test]

@@ -8,39 +8,12 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
+mod common;
+
 /// A 2000×2000 sphere scene: long enough to interrupt (seconds of rendering, a 50 MB EXR that
 /// takes a few hundred milliseconds to encode).
 fn big_scene(dir: &Path) -> PathBuf {
-    let path = dir.join("big.toml");
-    std::fs::write(
-        &path,
-        r#"
-[camera]
-position = [0.0, 0.0, 4.0]
-target = [0.0, 0.0, 0.0]
-fov = 35.0
-resolution = [2000, 2000]
-
-[[lights]]
-type = "point"
-position = [2.0, 2.0, 3.0]
-intensity = 10.0
-
-[materials.skin]
-type = "translucent"
-model = "better-dipole"
-preset = "skin1"
-units_per_mm = 0.1
-
-[[objects]]
-shape = "sphere"
-radius = 1.0
-subdivisions = 3
-material = "skin"
-"#,
-    )
-    .unwrap();
-    path
+    common::sphere_scene(dir, "big.toml", 2000, 2000)
 }
 
 fn scratch(name: &str) -> PathBuf {

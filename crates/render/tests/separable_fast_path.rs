@@ -7,8 +7,8 @@ use sss_render::frame::Frame;
 use sss_render::integrators::separable::screen_buffers;
 use sss_render::kernel_choice::{MaterialKernel, SeparableSettings, build_kernel, filter_options};
 use sss_render::scene::{BUILTIN_SCENES, LoadOptions, builtin};
+use sss_separable::NO_OBJECT;
 use sss_separable::screen_space::{Evaluation, filter_into_with};
-use sss_separable::{NO_OBJECT, ScreenInput};
 
 #[test]
 fn built_in_scenes_filter_identically_on_both_paths() {
@@ -45,29 +45,12 @@ fn built_in_scenes_filter_identically_on_both_paths() {
                     panic!("{name}: the default kernel is separable");
                 };
                 // The integrator's conversion: the material's pixels, in mm.
-                let u = sh.units_per_mm;
-                let mut e = vec![[0.0f32; 3]; w * h];
-                let mut depth = vec![0.0f32; w * h];
-                let mut mask = vec![NO_OBJECT; w * h];
-                let mut mm = vec![0.0f32; w * h];
-                for i in 0..w * h {
-                    let o = screen.object[i];
-                    if o == NO_OBJECT || scene.objects[o as usize].material != m {
-                        continue;
-                    }
-                    mask[i] = o;
-                    depth[i] = (screen.depth[i] / u) as f32;
-                    mm[i] = (screen.footprint[i] / u) as f32;
-                    e[i] = screen.irradiance[i].map(|v| v as f32);
-                }
-                let input = ScreenInput {
-                    width: w,
-                    height: h,
-                    irradiance: &e,
-                    depth: &depth,
-                    mask: &mask,
-                    mm_per_pixel: &mm,
-                };
+                let buffers = screen.material_input(&scene, m, sh.units_per_mm, w, h);
+                let (mask, mm, input) = (
+                    &buffers.mask[..],
+                    &buffers.mm_per_pixel[..],
+                    buffers.input(),
+                );
                 let run = |evaluation| {
                     let mut out = vec![[0.0f32; 3]; w * h];
                     let fast = filter_into_with(
@@ -91,7 +74,7 @@ fn built_in_scenes_filter_identically_on_both_paths() {
                 let shown = mask.iter().filter(|&&o| o != NO_OBJECT).count();
                 let blurred = mm
                     .iter()
-                    .zip(&mask)
+                    .zip(mask)
                     .filter(|&(&v, &o)| o != NO_OBJECT && 2.0 * kernel.support_mm as f32 / v >= 1.0)
                     .count();
                 eprintln!(
@@ -102,7 +85,7 @@ fn built_in_scenes_filter_identically_on_both_paths() {
                     {
                         let mut v: Vec<f32> = mm
                             .iter()
-                            .zip(&mask)
+                            .zip(mask)
                             .filter(|(_, o)| **o != NO_OBJECT)
                             .map(|(v, _)| *v)
                             .collect();

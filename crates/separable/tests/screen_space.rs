@@ -8,32 +8,8 @@ mod common;
 use common::Frame;
 use sss_separable::screen_space::{self, FilterOptions, rotation_angle};
 use sss_separable::{
-    NO_OBJECT, SeparableError, SeparableKernel, TapPlacement, convolve2d, gaussians, preintegrated,
-    svd,
+    NO_OBJECT, SeparableError, SeparableKernel, TapPlacement, convolve2d, preintegrated,
 };
-
-fn kernels() -> Vec<(&'static str, SeparableKernel)> {
-    let m = common::model("skin1");
-    let k = common::kernel2d(m.as_ref(), 31);
-    let g = gaussians::fit_model(m.as_ref(), 3).unwrap();
-    vec![
-        (
-            "pre-integrated 7",
-            preintegrated::kernel(&k, TapPlacement::Importance(7)).unwrap(),
-        ),
-        (
-            "svd rank 3",
-            svd::decompose(&k)
-                .unwrap()
-                .separable(3, TapPlacement::Grid)
-                .unwrap(),
-        ),
-        (
-            "3 gaussians",
-            g[2].kernel(k.total, TapPlacement::Importance(7)).unwrap(),
-        ),
-    ]
-}
 
 #[test]
 fn no_energy_crosses_a_silhouette() {
@@ -51,7 +27,7 @@ fn no_energy_crosses_a_silhouette() {
             jitter_radius: jitter,
             ..Default::default()
         };
-        for (name, kernel) in kernels() {
+        for (name, kernel) in common::screen_kernels() {
             let out = screen_space::filter(&f.input(), &kernel, &opts).unwrap();
             let total = kernel.total_weight();
             for y in 0..f.height {
@@ -103,7 +79,7 @@ fn a_depth_jump_stops_light_and_background_stays_black() {
             f.irradiance[i] = if x < 30 { [1.0; 3] } else { [0.0; 3] };
         }
     }
-    for (name, kernel) in kernels() {
+    for (name, kernel) in common::screen_kernels() {
         assert!(kernel.support_mm < 100.0);
         let out = screen_space::filter(&f.input(), &kernel, &FilterOptions::default()).unwrap();
         for y in 0..f.height {
@@ -195,7 +171,7 @@ fn results_do_not_depend_on_the_thread_count() {
         seed: 7,
         ..Default::default()
     };
-    for (name, kernel) in kernels() {
+    for (name, kernel) in common::screen_kernels() {
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -213,7 +189,7 @@ fn results_do_not_depend_on_the_thread_count() {
 
 #[test]
 fn sub_pixel_kernels_skip_the_blur_and_bad_pixels_stay_finite() {
-    let (_, kernel) = kernels().remove(0);
+    let (_, kernel) = common::screen_kernels().remove(0);
     let total = kernel.total_weight();
     // 2·support / mm_per_pixel < 1 pixel: output = irradiance × total reflectance.
     let mut f = Frame::flat(8, 6, (4.0 * kernel.support_mm) as f32);
@@ -238,7 +214,7 @@ fn sub_pixel_kernels_skip_the_blur_and_bad_pixels_stay_finite() {
 
 #[test]
 fn bad_input_is_an_error() {
-    let (_, kernel) = kernels().remove(0);
+    let (_, kernel) = common::screen_kernels().remove(0);
     let f = Frame::flat(8, 6, 0.1);
     let mut input = f.input();
     input.depth = &f.depth[..10];

@@ -8,33 +8,21 @@ mod common;
 
 use common::{BACKGROUND, Frame, hash01};
 use sss_separable::screen_space::{self, Evaluation, FilterOptions};
-use sss_separable::{SeparableKernel, TapPlacement, gaussians, preintegrated, svd};
+use sss_separable::{SeparableKernel, TapPlacement, preintegrated};
 
+/// The shared screen-space kernels and a uniform 15-tap one (taps that reach far).
 fn kernels() -> Vec<(&'static str, SeparableKernel)> {
     let m = common::model("skin1");
     let k = common::kernel2d(m.as_ref(), 31);
-    let g = gaussians::fit_model(m.as_ref(), 3).unwrap();
-    vec![
-        (
-            "pre-integrated 7",
-            preintegrated::kernel(&k, TapPlacement::Importance(7)).unwrap(),
-        ),
+    let mut all = common::screen_kernels();
+    all.insert(
+        1,
         (
             "pre-integrated 15 uniform",
             preintegrated::kernel(&k, TapPlacement::Uniform(15)).unwrap(),
         ),
-        (
-            "svd rank 3",
-            svd::decompose(&k)
-                .unwrap()
-                .separable(3, TapPlacement::Grid)
-                .unwrap(),
-        ),
-        (
-            "3 gaussians",
-            g[2].kernel(k.total, TapPlacement::Importance(7)).unwrap(),
-        ),
-    ]
+    );
+    all
 }
 
 /// The filtered image and the fraction of pixel passes on the fast path.

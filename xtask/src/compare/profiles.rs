@@ -593,21 +593,7 @@ mod tests {
 
     #[test]
     fn csv_has_the_documented_columns() {
-        let e = Evaluation {
-            preset: "skin1",
-            method: "pbd".into(),
-            channel: 2,
-            part: McPart::All,
-            bin_avg: vec![],
-            rel_l2: Some(0.5),
-            max_rel: None,
-            total_model: 0.25,
-            total_mc: 0.125,
-            total_mc_se: 0.001,
-            ns_per_eval: 12.5,
-            ns_per_rgb: 30.0,
-            build_seconds: 0.05,
-        };
+        let e = eval("skin1", "pbd", 2, 0.5);
         let csv = results_csv(&[e]);
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines[0], CSV_HEADER);

@@ -20,6 +20,7 @@ use crate::rng::{Stream, rng};
 use crate::shading::transmitted_irradiance;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
+use sss_scene::Scene;
 use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
 
 /// Pixels (or samples) per parallel task of the per-pixel loops: enough work per task that the
@@ -216,36 +217,9 @@ impl Integrator for Separable {
             let (Some(kernel), Some(sh)) = (kernel, frame.shading[m].as_ref()) else {
                 continue;
             };
-            let u = sh.units_per_mm;
-            let mut e = vec![[0.0f32; 3]; w * h];
-            let mut depth = vec![0.0f32; w * h];
-            let mut mask = vec![NO_OBJECT; w * h];
-            let mut mm = vec![0.0f32; w * h];
-            e.par_iter_mut()
-                .zip(depth.par_iter_mut())
-                .zip(mask.par_iter_mut())
-                .zip(mm.par_iter_mut())
-                .enumerate()
-                .with_min_len(PIXELS_PER_TASK)
-                .for_each(|(i, (((e, depth), mask), mm))| {
-                    let o = screen.object[i];
-                    if o == NO_OBJECT || scene.objects[o as usize].material != m {
-                        return;
-                    }
-                    *mask = o;
-                    *depth = (screen.depth[i] / u) as f32;
-                    *mm = (screen.footprint[i] / u) as f32;
-                    *e = screen.irradiance[i].map(|v| v as f32);
-                });
-            let input = ScreenInput {
-                width: w,
-                height: h,
-                irradiance: &e,
-                depth: &depth,
-                mask: &mask,
-                mm_per_pixel: &mm,
-            };
-            let pixels = mask.iter().filter(|&&o| o != NO_OBJECT).count();
+            let buffers = screen.material_input(scene, m, sh.units_per_mm, w, h);
+            let input = buffers.input();
+            let pixels = buffers.mask.iter().filter(|&&o| o != NO_OBJECT).count();
             let filtered = match kernel {
                 MaterialKernel::Separable(k) => {
                     taps += pixels * k.taps_per_pixel();
@@ -327,6 +301,78 @@ impl ScreenBuffers {
                 pixels: surface,
             },
         ]
+    }
+}
+
+/// One material's screen-space inputs in mm, as `sss_separable::screen_space` takes them.
+#[derive(Clone, Debug)]
+pub struct MaterialInput {
+    /// Image width (pixels).
+    pub width: usize,
+    /// Image height (pixels).
+    pub height: usize,
+    /// Irradiance of the material's pixels, 0 elsewhere.
+    pub irradiance: Vec<[f32; 3]>,
+    /// Distance from the camera (mm).
+    pub depth: Vec<f32>,
+    /// Object id of the material's pixels, [`NO_OBJECT`] elsewhere.
+    pub mask: Vec<u32>,
+    /// Pixel footprint (mm).
+    pub mm_per_pixel: Vec<f32>,
+}
+
+impl MaterialInput {
+    /// The buffers as the filter's input.
+    pub fn input(&self) -> ScreenInput<'_> {
+        ScreenInput {
+            width: self.width,
+            height: self.height,
+            irradiance: &self.irradiance,
+            depth: &self.depth,
+            mask: &self.mask,
+            mm_per_pixel: &self.mm_per_pixel,
+        }
+    }
+}
+
+impl ScreenBuffers {
+    /// The pixels of `scene`'s material `material` (of a `width` × `height` image), converted
+    /// from scene units to mm with `units_per_mm`; every other pixel is background.
+    pub fn material_input(
+        &self,
+        scene: &Scene,
+        material: usize,
+        units_per_mm: f64,
+        width: usize,
+        height: usize,
+    ) -> MaterialInput {
+        let n = width * height;
+        let mut b = MaterialInput {
+            width,
+            height,
+            irradiance: vec![[0.0; 3]; n],
+            depth: vec![0.0; n],
+            mask: vec![NO_OBJECT; n],
+            mm_per_pixel: vec![0.0; n],
+        };
+        b.irradiance
+            .par_iter_mut()
+            .zip(b.depth.par_iter_mut())
+            .zip(b.mask.par_iter_mut())
+            .zip(b.mm_per_pixel.par_iter_mut())
+            .enumerate()
+            .with_min_len(PIXELS_PER_TASK)
+            .for_each(|(i, (((e, depth), mask), mm))| {
+                let o = self.object[i];
+                if o == NO_OBJECT || scene.objects[o as usize].material != material {
+                    return;
+                }
+                *mask = o;
+                *depth = (self.depth[i] / units_per_mm) as f32;
+                *mm = (self.footprint[i] / units_per_mm) as f32;
+                *e = self.irradiance[i].map(|v| v as f32);
+            });
+        b
     }
 }
 

@@ -212,15 +212,13 @@ impl Rules {
     /// 1/mm_per_pixel if the pixel is blurred, None if it skips the blur.
     #[inline(always)]
     pub fn inverse_scale(&self, mm_per_pixel: f32) -> Option<f32> {
-        if !(mm_per_pixel > 0.0) || !mm_per_pixel.is_finite() {
-            return None;
-        }
-        let inv = 1.0 / mm_per_pixel;
-        (2.0 * self.support_mm * inv >= self.min_footprint_px && inv.is_finite()).then_some(inv)
+        let (inv, blurred) = self.inverse_scale_lane(mm_per_pixel);
+        blurred.then_some(inv)
     }
 
-    /// [`Rules::inverse_scale`] without branches (so a loop over pixels vectorises): the same
-    /// 1/mm_per_pixel, and whether the pixel is blurred.
+    /// [`Rules::inverse_scale`] without branches (so a loop over pixels vectorises):
+    /// 1/mm_per_pixel, and whether the pixel is blurred (a positive, finite footprint whose
+    /// kernel spans at least `min_footprint_px`).
     #[inline(always)]
     pub fn inverse_scale_lane(&self, mm_per_pixel: f32) -> (f32, bool) {
         let inv = 1.0 / mm_per_pixel;

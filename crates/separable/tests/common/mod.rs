@@ -2,7 +2,10 @@
 #![allow(dead_code)]
 
 use sss_bssrdf::{Bssrdf, Medium, ModelKind, make_model};
-use sss_separable::{Kernel2d, Kernel2dSpec, NO_OBJECT, ScreenInput};
+use sss_separable::{
+    Kernel2d, Kernel2dSpec, NO_OBJECT, ScreenInput, SeparableKernel, TapPlacement, gaussians,
+    preintegrated, svd,
+};
 
 /// The better dipole for a measured material.
 pub fn model(preset: &str) -> Box<dyn Bssrdf> {
@@ -22,6 +25,31 @@ pub fn kernel2d(m: &dyn Bssrdf, cells: usize) -> Kernel2d {
         },
     )
     .expect("kernel")
+}
+
+/// The screen-space tests' kernels (skin1, 31² grid): pre-integrated with 7 importance taps,
+/// SVD rank 3 (signed terms) and 3 Gaussians (several terms).
+pub fn screen_kernels() -> Vec<(&'static str, SeparableKernel)> {
+    let m = model("skin1");
+    let k = kernel2d(m.as_ref(), 31);
+    let g = gaussians::fit_model(m.as_ref(), 3).unwrap();
+    vec![
+        (
+            "pre-integrated 7",
+            preintegrated::kernel(&k, TapPlacement::Importance(7)).unwrap(),
+        ),
+        (
+            "svd rank 3",
+            svd::decompose(&k)
+                .unwrap()
+                .separable(3, TapPlacement::Grid)
+                .unwrap(),
+        ),
+        (
+            "3 gaussians",
+            g[2].kernel(k.total, TapPlacement::Importance(7)).unwrap(),
+        ),
+    ]
 }
 
 /// Owned buffers of a screen-space test image.
