@@ -120,6 +120,19 @@ impl TranslucentShading {
         [rd[0] * s, rd[1] * s, rd[2] * s]
     }
 
+    /// The R_d an irradiance sample of area `area` (scene units²) contributes per unit area at
+    /// scene-unit distance `r` from the shading point: the sample stands for a patch of the
+    /// surface, so near the shading point (where R_d is peaked) this is meant to be R_d
+    /// averaged over the sample's disk rather than the point value. Every point-sum method
+    /// (`exact`, the tree leaves) calls this, so they approximate the same sum.
+    ///
+    /// Today: the point value [`rd_scene`](Self::rd_scene) (`area` unused).
+    #[inline]
+    pub fn rd_sample_scene(&self, r: f64, area: f64) -> Rgb {
+        let _ = area;
+        self.rd_scene(r)
+    }
+
     /// The exit weight F_t(η, n·ω_o)/(cπ) of a radial model at a point with shading normal `n`
     /// seen from direction `wo`.
     #[inline]

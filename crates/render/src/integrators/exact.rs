@@ -167,7 +167,7 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
         return sum;
     }
     for s in &samples.samples {
-        let rd = shading.rd_scene((s.position - g.p).length());
+        let rd = shading.rd_sample_scene((s.position - g.p).length(), s.area);
         for c in 0..3 {
             sum[c] += rd[c] * s.irradiance[c] * s.area;
         }
