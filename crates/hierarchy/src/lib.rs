@@ -12,6 +12,12 @@
 //!   stage of a hierarchical BSSRDF integrator needs (Jensen & Buhler 2002): the outgoing
 //!   radiance is estimated as `Σ R_d(|x - x_i|) · E_i · A_i` over the samples. Evenly
 //!   spread points with accurate, low-variance areas `A_i` keep that sum's error small.
+//! * [`IrradianceTree`] and [`PixelTree`]: kd-trees ([`KdTree`], flat arrays, a contiguous
+//!   range per node) over irradiance samples and over shading points in screen space, with
+//!   the node aggregates of Jensen & Buhler 2002 (area, flux, irradiance-weighted position)
+//!   and Milaenen et al. 2019 §4.2 (world bounds, mean position/normal/view, max s_p). Use
+//!   them for hierarchical point sums: the single-tree (Jensen & Buhler) and dual-tree
+//!   (Milaenen) traversals of `sss-render` walk them.
 //!
 //! ## Example
 //!
@@ -70,9 +76,15 @@
 
 pub mod blue_noise;
 mod bvh;
+pub mod irradiance_tree;
+pub mod kdtree;
+pub mod pixel_tree;
 
 pub use blue_noise::{BlueNoiseStats, SurfaceSample, blue_noise_on_mesh};
 pub use bvh::{Hit, TriangleBvh, intersect_triangle};
+pub use irradiance_tree::{IrradianceCluster, IrradiancePoint, IrradianceTree};
+pub use kdtree::{KdNode, KdTree};
+pub use pixel_tree::{PixelCluster, PixelPoint, PixelTree};
 
 #[cfg(test)]
 mod send_sync {

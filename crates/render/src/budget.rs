@@ -190,17 +190,33 @@ pub fn check_irradiance(
     settings: &IrradianceSettings,
     budget: u64,
 ) -> Result<(), Error> {
+    check_irradiance_with(scene, settings, |_| 0, budget)
+}
+
+/// [`check_irradiance`] for a method that also builds structures over the samples and pixels
+/// (trees): `structures` gives their bytes from the per-object sample estimates
+/// ([`irradiance_estimate`]), and they count towards the same budget.
+pub fn check_irradiance_with(
+    scene: &Scene,
+    settings: &IrradianceSettings,
+    structures: impl Fn(&[(usize, u64, u64)]) -> u64,
+    budget: u64,
+) -> Result<(), Error> {
     let cam = &scene.camera;
     let frame = frame_bytes(cam.width, cam.height, cam.pixel_samples);
     let est = irradiance_estimate(scene, settings);
-    let samples = est.iter().fold(0u64, |a, e| a.saturating_add(e.2));
+    let samples = est
+        .iter()
+        .fold(0u64, |a, e| a.saturating_add(e.2))
+        .saturating_add(structures(&est));
     let needed = frame.saturating_add(samples);
     if needed > budget {
         let (o, count, _) = est.iter().max_by_key(|e| e.2).copied().unwrap_or_default();
         let name = scene.objects.get(o).map_or("", |ob| ob.name.as_str());
         return Err(Error::Input(format!(
             "scene {}: irradiance samples (--max-samples {}, --spacing {} mean free paths; \
-             up to {count} on object `{name}`) need about {samples} bytes ({}) on top of the \
+             up to {count} on object `{name}`) and the method's structures over them need \
+             about {samples} bytes ({}) on top of the \
              frame's {frame} bytes, over the memory budget of {budget} bytes ({}); lower \
              --max-samples, raise --spacing or raise --max-memory",
             scene.name,

@@ -103,7 +103,12 @@ pub fn render(
     check_scene(scene)?;
     crate::budget::check_frame(scene, settings.max_memory)?;
     if let Some(irradiance) = integrator.irradiance_settings() {
-        crate::budget::check_irradiance(scene, &irradiance, settings.max_memory)?;
+        crate::budget::check_irradiance_with(
+            scene,
+            &irradiance,
+            |est| integrator.structure_bytes(scene, est),
+            settings.max_memory,
+        )?;
     }
     let frame = Frame::prepare(scene, settings.seed);
     progress.start(frame.gbuffer.samples.len() as u64);

@@ -21,10 +21,12 @@
 //! entry (name, options, constructor, compare sweep), and one line in [`METHODS`]. The `sss
 //! render` flags, the `cargo xtask compare` sweep and the pipeline all read the registry.
 
+pub mod dual_tree;
 pub mod exact;
 pub mod options;
 pub mod pathtrace;
 pub mod separable;
+pub mod single_tree;
 
 pub use options::{MethodOptions, OptionKind, OptionSpec};
 
@@ -33,6 +35,7 @@ use crate::frame::Frame;
 use crate::irradiance::IrradianceSettings;
 use crate::progress::Progress;
 use sss_bssrdf::Rgb;
+use sss_scene::Scene;
 
 /// One method's output on a frame.
 #[derive(Clone, Debug, Default)]
@@ -82,6 +85,14 @@ pub trait Integrator: Send + Sync {
     fn irradiance_settings(&self) -> Option<IrradianceSettings> {
         None
     }
+    /// Bytes of the method's own structures (trees over irradiance samples or pixels), from
+    /// the scene and the per-object irradiance-sample estimates of
+    /// [`crate::budget::irradiance_estimate`] (object, count, bytes): counted with the samples
+    /// against `--max-memory` before the frame is built.
+    fn structure_bytes(&self, scene: &Scene, samples: &[(usize, u64, u64)]) -> u64 {
+        let _ = (scene, samples);
+        0
+    }
     /// Shades every G-buffer sample on a visible translucent object of `frame`.
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error>;
 }
@@ -114,7 +125,13 @@ pub struct Method {
 }
 
 /// Every rendering method, in report order.
-pub const METHODS: &[Method] = &[exact::METHOD, pathtrace::METHOD, separable::METHOD];
+pub const METHODS: &[Method] = &[
+    exact::METHOD,
+    pathtrace::METHOD,
+    separable::METHOD,
+    single_tree::METHOD,
+    dual_tree::METHOD,
+];
 
 /// The registry entry named `name`.
 pub fn method(name: &str) -> Result<&'static Method, Error> {
