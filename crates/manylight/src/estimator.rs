@@ -76,12 +76,18 @@ impl<F: Fn(DVec3, DVec3) -> bool + Sync> Visibility for F {
 }
 
 /// Which confidence interval to stop on (see the module doc).
+///
+/// On the test scene of `tests/estimator.rs` (ε = 3 %, α = 95 %, 1000 seeds) the truth lay
+/// inside the interval 94.0 % of the time with [`Interval::StandardError`] and 99.4 % with
+/// [`Interval::Paper`] (the normal prediction for a √2-wider interval: P(|Z| < 2.77) = 99.4 %).
+/// The paper reports an estimation accuracy of 94.8–94.9 % at α = 95 %, which matches the
+/// standard-error form, so that is the default.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Interval {
     /// Eq. 9 as printed: ΔI = t_α √(Σ s_j²).
-    #[default]
     Paper,
     /// The stratified-sampling standard error: ΔI = t_α √(Σ s_j²/2).
+    #[default]
     StandardError,
 }
 
@@ -106,7 +112,7 @@ pub struct Settings {
 
 impl Settings {
     /// ε = 2 %, BSSRDF-aware selection, the given G clamp, 100 000 triplets, 32 768 splits
-    /// (about 13 MB of arena), at least 8 triplets, the paper's interval.
+    /// (about 13 MB of arena), at least 8 triplets, the standard-error interval.
     pub fn new(g_max: f64) -> Settings {
         Settings {
             epsilon: 0.02,
@@ -115,7 +121,7 @@ impl Settings {
             max_triplets: 100_000,
             max_splits: 32_768,
             min_triplets: 8,
-            interval: Interval::Paper,
+            interval: Interval::StandardError,
         }
     }
 
