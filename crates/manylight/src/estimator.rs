@@ -448,11 +448,9 @@ impl<'a> Estimator<'a> {
         let ln = self.lights.node(t.l);
         let sn = shading.node(t.s);
         let ibox = refs.bbox(self.surface, t.i);
-        let mut splittable = [
-            ln.children.is_some(),
-            refs.can_split(self.surface, t.i),
-            sn.children.is_some(),
-        ];
+        // An irradiance cluster can always be halved in principle; when the split cap refuses
+        // it, `split` counts the event and the other clusters are considered.
+        let mut splittable = [ln.children.is_some(), true, sn.children.is_some()];
         loop {
             let kind = bounds::select(
                 self.settings.selection,
