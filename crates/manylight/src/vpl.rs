@@ -105,7 +105,7 @@ impl NormalCone {
     /// half-angle is (φ + θ₁ + θ₂)/2 with φ the angle between the axes, the axis rotated from
     /// `self.axis` towards `o.axis`; Walter et al. 2006 keep such cones per node).
     pub fn union(self, o: NormalCone) -> NormalCone {
-        let phi = self.axis.dot(o.axis).clamp(-1.0, 1.0).acos();
+        let phi = angle_between(self.axis, o.axis);
         if phi + o.half_angle <= self.half_angle {
             return self;
         }
@@ -130,8 +130,14 @@ impl NormalCone {
 
     /// True if unit direction `d` lies in the cone (with a 1e-9 rad tolerance).
     pub fn contains(&self, d: DVec3) -> bool {
-        self.axis.dot(d).clamp(-1.0, 1.0).acos() <= self.half_angle + 1e-9
+        angle_between(self.axis, d) <= self.half_angle + 1e-9
     }
+}
+
+/// The angle between two unit vectors as atan2(‖a × b‖, a · b), accurate near 0 and π (unlike
+/// acos of the dot product, which loses half the digits there).
+fn angle_between(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
 }
 
 /// A node of the [`LightTree`].
