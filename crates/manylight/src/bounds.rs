@@ -146,7 +146,11 @@ pub fn select(
     profile: &RadialProfile,
     g_max: f64,
 ) -> Option<ClusterKind> {
-    let kinds = [ClusterKind::Light, ClusterKind::Irradiance, ClusterKind::Shading];
+    let kinds = [
+        ClusterKind::Light,
+        ClusterKind::Irradiance,
+        ClusterKind::Shading,
+    ];
     let score: [f64; 3] = match selection {
         Selection::BssrdfAware => {
             let [l, i, s] = boxes.map(|b| b.sphere());

@@ -50,13 +50,13 @@ use std::collections::BinaryHeap;
 
 use glam::DVec3;
 
+use crate::Error;
 use crate::bounds::{self, ClusterKind, Selection};
 use crate::confidence::StudentT;
 use crate::irradiance_cluster::{IcId, IrradianceTree, Refinements};
 use crate::profile::{RadialProfile, Transmittance, luminance};
 use crate::shading_cluster::ShadingTree;
 use crate::vpl::LightTree;
-use crate::Error;
 
 /// Samples per triplet (the paper's n_j = 2).
 pub const SAMPLES_PER_TRIPLET: u32 = 2;
@@ -144,7 +144,10 @@ impl Settings {
             return bad(format!("G_max = {} must be finite and > 0", self.g_max));
         }
         if self.max_triplets == 0 || self.max_triplets > (1 << 30) {
-            return bad(format!("max_triplets = {} must be in 1..=2^30", self.max_triplets));
+            return bad(format!(
+                "max_triplets = {} must be in 1..=2^30",
+                self.max_triplets
+            ));
         }
         if self.min_triplets == 0 {
             return bad("min_triplets must be ≥ 1".into());
@@ -547,13 +550,10 @@ impl<'a> Estimator<'a> {
                 continue;
             }
             let rd = self.profile.eval(xi.distance(xo));
-            let mut rgb = [0.0; 3];
-            for c in 0..3 {
-                rgb[c] = scale * vpl.intensity[c] / lum * rd[c] * h;
-            }
+            let rgb: [f64; 3] = std::array::from_fn(|c| scale * vpl.intensity[c] / lum * rd[c] * h);
             *fk = luminance(rgb);
-            for c in 0..3 {
-                t.rgb[c] += 0.5 * rgb[c];
+            for (acc, v) in t.rgb.iter_mut().zip(rgb) {
+                *acc += 0.5 * v;
             }
         }
         t.value = 0.5 * (f[0] + f[1]);

@@ -7,8 +7,8 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use crate::aabb::Aabb;
 use crate::Error;
+use crate::aabb::Aabb;
 
 /// A triangle with its area and unit geometric normal (from the winding: counter-clockwise seen
 /// from the side the normal points to; the estimator treats that side as outside).
@@ -138,7 +138,10 @@ impl IrradianceTree {
         if !(total.is_finite() && total > 0.0) {
             return Err(Error::InvalidInput(format!("mesh area {total} is not > 0")));
         }
-        let centroids: Vec<DVec3> = tris.iter().map(|t| (t.v[0] + t.v[1] + t.v[2]) / 3.0).collect();
+        let centroids: Vec<DVec3> = tris
+            .iter()
+            .map(|t| (t.v[0] + t.v[1] + t.v[2]) / 3.0)
+            .collect();
         let mut order: Vec<u32> = (0..tris.len() as u32).collect();
         let mut nodes = Vec::with_capacity(2 * tris.len() - 1);
         let blank = IcNode {
@@ -395,7 +398,11 @@ impl Refinements {
                     let (wa, wb) = (tree.nodes[a as usize].area, tree.nodes[b as usize].area);
                     let pa = if wa + wb > 0.0 { wa / (wa + wb) } else { 1.0 };
                     if u0 < pa || wb <= 0.0 {
-                        u0 = if pa > 0.0 { (u0 / pa).min(1.0 - f64::EPSILON) } else { 0.0 };
+                        u0 = if pa > 0.0 {
+                            (u0 / pa).min(1.0 - f64::EPSILON)
+                        } else {
+                            0.0
+                        };
                         n = a;
                     } else {
                         u0 = ((u0 - pa) / (1.0 - pa)).clamp(0.0, 1.0 - f64::EPSILON);

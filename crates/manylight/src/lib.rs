@@ -81,9 +81,7 @@ pub mod vpl;
 pub use aabb::{Aabb, Sphere};
 pub use bounds::{ClusterKind, Selection};
 pub use confidence::StudentT;
-pub use estimator::{
-    Estimator, Interval, PixelEstimate, Settings, Status, Visibility, pixel_seed,
-};
+pub use estimator::{Estimator, Interval, PixelEstimate, Settings, Status, Visibility, pixel_seed};
 pub use irradiance_cluster::{IcId, IrradianceTree, Refinements, Triangle};
 pub use profile::{LUMINANCE, RadialProfile, Transmittance, luminance};
 pub use shading_cluster::{ShadingPoint, ShadingTree};

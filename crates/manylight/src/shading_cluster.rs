@@ -4,8 +4,8 @@
 
 use glam::DVec3;
 
-use crate::aabb::Aabb;
 use crate::Error;
+use crate::aabb::Aabb;
 
 /// A shading point x_o with its weight w(x_o) = W(x_o) F_t(x_o) / (π p(x_o) |S|) (Eq. 2): the
 /// caller folds the pixel filter, the exit Fresnel factor and the sample count into `weight`,
@@ -150,7 +150,11 @@ impl ShadingTree {
             let (wa, wb) = (self.nodes[a as usize].weight, self.nodes[b as usize].weight);
             let pa = if wa + wb > 0.0 { wa / (wa + wb) } else { 1.0 };
             if u < pa || wb <= 0.0 {
-                u = if pa > 0.0 { (u / pa).min(1.0 - f64::EPSILON) } else { 0.0 };
+                u = if pa > 0.0 {
+                    (u / pa).min(1.0 - f64::EPSILON)
+                } else {
+                    0.0
+                };
                 id = a;
             } else {
                 u = ((u - pa) / (1.0 - pa)).clamp(0.0, 1.0 - f64::EPSILON);

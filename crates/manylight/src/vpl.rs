@@ -4,9 +4,9 @@
 
 use glam::DVec3;
 
+use crate::Error;
 use crate::aabb::Aabb;
 use crate::profile::luminance;
-use crate::Error;
 
 /// What kind of emitter a VPL is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -176,7 +176,10 @@ impl LightTree {
             return Err(Error::InvalidInput("no VPLs".into()));
         }
         if vpls.len() > (1 << 31) {
-            return Err(Error::InvalidInput(format!("{} VPLs (at most 2^31)", vpls.len())));
+            return Err(Error::InvalidInput(format!(
+                "{} VPLs (at most 2^31)",
+                vpls.len()
+            )));
         }
         for (k, v) in vpls.iter().enumerate() {
             v.validate(k)?;
@@ -219,7 +222,10 @@ impl LightTree {
             let Some([a, b]) = n.children else {
                 return (n.vpl, if n.intensity > 0.0 { p } else { 0.0 });
             };
-            let (wa, wb) = (self.nodes[a as usize].intensity, self.nodes[b as usize].intensity);
+            let (wa, wb) = (
+                self.nodes[a as usize].intensity,
+                self.nodes[b as usize].intensity,
+            );
             let w = wa + wb;
             if w <= 0.0 {
                 id = a;
@@ -229,7 +235,11 @@ impl LightTree {
             let pa = wa / w;
             if u < pa || wb <= 0.0 {
                 p *= pa;
-                u = if pa > 0.0 { (u / pa).min(1.0 - f64::EPSILON) } else { 0.0 };
+                u = if pa > 0.0 {
+                    (u / pa).min(1.0 - f64::EPSILON)
+                } else {
+                    0.0
+                };
                 id = a;
             } else {
                 let pb = wb / w;
@@ -295,7 +305,10 @@ fn build(vpls: &[Vpl], idx: &mut [u32], nodes: &mut Vec<LightNode>) {
         };
         // Sort by the axis coordinate, ties by index, so the tree is a function of the input.
         range.sort_unstable_by(|&p, &q| {
-            let (a, c) = (vpls[p as usize].position[axis], vpls[q as usize].position[axis]);
+            let (a, c) = (
+                vpls[p as usize].position[axis],
+                vpls[q as usize].position[axis],
+            );
             a.total_cmp(&c).then(p.cmp(&q))
         });
         let mid = j.lo + range.len() / 2;

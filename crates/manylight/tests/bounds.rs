@@ -54,7 +54,10 @@ fn points_in(b: &Aabb, n: usize, u: &mut U) -> Vec<DVec3> {
 fn random_box(u: &mut U, spread: f64) -> Aabb {
     let c = (u.v() - 0.5) * spread;
     let h = u.v() * u.v() * 0.5; // from points to wide boxes
-    Aabb { min: c - h, max: c + h }
+    Aabb {
+        min: c - h,
+        max: c + h,
+    }
 }
 
 #[test]
@@ -65,9 +68,16 @@ fn rd_g_ft_and_error_bounds_are_never_exceeded() {
     let mut u = U(11);
     let mut tight = 0usize;
     for trial in 0..400 {
-        let (lc, ic, sc) = (random_box(&mut u, 2.0), random_box(&mut u, 2.0), random_box(&mut u, 2.0));
-        let (ps_l, ps_i, ps_s) =
-            (points_in(&lc, 12, &mut u), points_in(&ic, 12, &mut u), points_in(&sc, 12, &mut u));
+        let (lc, ic, sc) = (
+            random_box(&mut u, 2.0),
+            random_box(&mut u, 2.0),
+            random_box(&mut u, 2.0),
+        );
+        let (ps_l, ps_i, ps_s) = (
+            points_in(&lc, 12, &mut u),
+            points_in(&ic, 12, &mut u),
+            points_in(&sc, 12, &mut u),
+        );
         let rd_u = rd_upper(&profile, &ic, &sc);
         let g_u = g_upper(&lc, &ic, g_max);
         let ft_u = ft_upper(&trans);
@@ -75,10 +85,14 @@ fn rd_g_ft_and_error_bounds_are_never_exceeded() {
         let m = sample_bound(a, w, i, rd_u, g_u, ft_u);
         let e = error_bound(m, 2);
         assert!((e - m / (2.0 * 2f64.sqrt())).abs() <= 1e-15 * m);
-        let sphere_upper = selection_upper(&lc.sphere(), &ic.sphere(), &sc.sphere(), &profile, g_max);
+        let sphere_upper =
+            selection_upper(&lc.sphere(), &ic.sphere(), &sc.sphere(), &profile, g_max);
         let lower = selection_lower(&lc.sphere(), &ic.sphere(), &sc.sphere(), &profile, g_max);
         for l in lower {
-            assert!(l <= sphere_upper * (1.0 + 1e-12), "lower {l} above upper {sphere_upper}");
+            assert!(
+                l <= sphere_upper * (1.0 + 1e-12),
+                "lower {l} above upper {sphere_upper}"
+            );
         }
         // Exhaustive over the point sets: all L × I × S combinations.
         let mut values = Vec::new();
@@ -88,7 +102,10 @@ fn rd_g_ft_and_error_bounds_are_never_exceeded() {
                 let r = xi.distance(*xo);
                 let v = rd(r);
                 let vmax = v[0].max(v[1]).max(v[2]);
-                assert!(vmax <= rd_u * (1.0 + 1e-12), "trial {trial}: R_d {vmax} > {rd_u}");
+                assert!(
+                    vmax <= rd_u * (1.0 + 1e-12),
+                    "trial {trial}: R_d {vmax} > {rd_u}"
+                );
                 rd_seen = rd_seen.max(vmax);
                 for y in &ps_l {
                     let d2 = y.distance_squared(*xi);
@@ -113,7 +130,10 @@ fn rd_g_ft_and_error_bounds_are_never_exceeded() {
         let n = values.len() as f64;
         let mean = values.iter().sum::<f64>() / n;
         let sd = (values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n).sqrt();
-        assert!(sd / 2f64.sqrt() <= e * (1.0 + 1e-12), "trial {trial}: {sd} vs e {e}");
+        assert!(
+            sd / 2f64.sqrt() <= e * (1.0 + 1e-12),
+            "trial {trial}: {sd} vs e {e}"
+        );
         // The R_d bound is attained when the boxes are apart (a corner pair realises r_min
         // along one axis only, so count how often it is within 1 %).
         if rd_seen >= 0.99 * rd_u {
@@ -121,7 +141,10 @@ fn rd_g_ft_and_error_bounds_are_never_exceeded() {
         }
     }
     // The bound is not vacuous: often nearly attained by the sampled points.
-    assert!(tight > 40, "R_d bound nearly attained in {tight} of 400 trials");
+    assert!(
+        tight > 40,
+        "R_d bound nearly attained in {tight} of 400 trials"
+    );
 }
 
 #[test]
@@ -151,12 +174,18 @@ fn monotone_models_are_accepted_and_others_refused() {
     assert!(RadialProfile::new(rd, 10.0).is_ok());
     // Rising somewhere: refused with a clear error.
     let bump = |r: f64| [(-r).exp() + if (1.0..1.5).contains(&r) { 0.1 } else { 0.0 }; 3];
-    assert!(matches!(RadialProfile::new(bump, 2.0), Err(Error::InvalidModel(_))));
+    assert!(matches!(
+        RadialProfile::new(bump, 2.0),
+        Err(Error::InvalidModel(_))
+    ));
     assert!(matches!(
         RadialProfile::new(|_| [f64::NAN; 3], 1.0),
         Err(Error::InvalidModel(_))
     ));
-    assert!(matches!(RadialProfile::new(|r| [-r; 3], 1.0), Err(Error::InvalidModel(_))));
+    assert!(matches!(
+        RadialProfile::new(|r| [-r; 3], 1.0),
+        Err(Error::InvalidModel(_))
+    ));
     assert!(RadialProfile::new(rd, 0.0).is_err());
     // Dielectric F_t rises with cos θ: accepted, bound = normal incidence = 1 − ((η−1)/(η+1))².
     let t = Transmittance::new(ft).unwrap();
@@ -171,8 +200,19 @@ fn monotone_models_are_accepted_and_others_refused() {
 #[test]
 fn student_t_quantiles_match_published_tables() {
     let t95 = StudentT::new(0.95).unwrap();
-    for (nu, want) in [(1, 12.706), (2, 4.303), (5, 2.571), (10, 2.228), (30, 2.042), (100, 1.984)] {
-        assert!((t95.quantile(nu) - want).abs() < 6e-4, "ν = {nu}: {}", t95.quantile(nu));
+    for (nu, want) in [
+        (1, 12.706),
+        (2, 4.303),
+        (5, 2.571),
+        (10, 2.228),
+        (30, 2.042),
+        (100, 1.984),
+    ] {
+        assert!(
+            (t95.quantile(nu) - want).abs() < 6e-4,
+            "ν = {nu}: {}",
+            t95.quantile(nu)
+        );
     }
     assert!((t95.quantile(10_000) - 1.960201).abs() < 2e-6);
     assert!((t95.quantile(10_000_000) - 1.959964).abs() < 2e-6);

@@ -111,7 +111,10 @@ fn the_interval_covers_the_truth_about_alpha_of_the_time() {
         let acc = within_eps as f64 / n as f64;
         eprintln!("{interval:?}: coverage {cov}, accuracy {acc}");
         assert!(cov >= lo && cov <= hi, "{interval:?}: coverage {cov}");
-        assert!(acc >= lo - 0.01 && acc <= hi + 0.01, "{interval:?}: accuracy {acc}");
+        assert!(
+            acc >= lo - 0.01 && acc <= hi + 0.01,
+            "{interval:?}: accuracy {acc}"
+        );
     }
 }
 
@@ -134,20 +137,40 @@ fn black_pixels_stop_at_once_by_the_bound() {
     let s = scene();
     let (p, t) = mesh();
     // Zero power.
-    let black = LightTree::new(vpls().into_iter().map(|v| Vpl { intensity: [0.0; 3], ..v }).collect())
-        .unwrap();
+    let black = LightTree::new(
+        vpls()
+            .into_iter()
+            .map(|v| Vpl {
+                intensity: [0.0; 3],
+                ..v
+            })
+            .collect(),
+    )
+    .unwrap();
     let surface = IrradianceTree::new(&p, &t).unwrap();
-    let est = Estimator::new(&black, &surface, &s.profile, &s.ft, &s.t, Settings::new(G_MAX))
-        .unwrap();
+    let est = Estimator::new(
+        &black,
+        &surface,
+        &s.profile,
+        &s.ft,
+        &s.t,
+        Settings::new(G_MAX),
+    )
+    .unwrap();
     let px = est.estimate(&s.shading, &vis(), 5);
     assert_eq!((px.status, px.triplets, px.samples), (Status::Exact, 1, 0));
     assert_eq!(px.rgb, [0.0; 3]);
     // Zero shading weights: the same.
-    let zero_w: Vec<ShadingPoint> =
-        shading_points().into_iter().map(|p| ShadingPoint { weight: 0.0, ..p }).collect();
+    let zero_w: Vec<ShadingPoint> = shading_points()
+        .into_iter()
+        .map(|p| ShadingPoint { weight: 0.0, ..p })
+        .collect();
     let est = estimator(&s, Settings::new(G_MAX));
     let px = est.estimate(&ShadingTree::new(zero_w).unwrap(), &vis(), 5);
-    assert_eq!((px.status, px.triplets, px.rgb), (Status::Exact, 1, [0.0; 3]));
+    assert_eq!(
+        (px.status, px.triplets, px.rgb),
+        (Status::Exact, 1, [0.0; 3])
+    );
 }
 
 #[test]
@@ -210,7 +233,10 @@ fn estimates_are_bit_identical_across_runs_and_threads() {
     let v = vis();
     let seeds: Vec<u64> = (0..16).map(|k| pixel_seed(42, k)).collect();
     let one = |seeds: &[u64]| -> Vec<PixelEstimate> {
-        seeds.iter().map(|&sd| est.estimate(&s.shading, &v, sd)).collect()
+        seeds
+            .iter()
+            .map(|&sd| est.estimate(&s.shading, &v, sd))
+            .collect()
     };
     let serial = one(&seeds);
     let again = one(&seeds);
@@ -223,7 +249,12 @@ fn estimates_are_bit_identical_across_runs_and_threads() {
     let threaded: Vec<PixelEstimate> = pa.into_iter().chain(pb).collect();
     let bits = |v: &[PixelEstimate]| -> Vec<u64> {
         v.iter()
-            .flat_map(|p| p.rgb.iter().chain([&p.value, &p.delta]).map(|x| x.to_bits()))
+            .flat_map(|p| {
+                p.rgb
+                    .iter()
+                    .chain([&p.value, &p.delta])
+                    .map(|x| x.to_bits())
+            })
             .collect()
     };
     assert_eq!(bits(&serial), bits(&again));

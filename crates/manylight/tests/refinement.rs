@@ -39,13 +39,18 @@ fn halving_conserves_area_and_halves_the_longest_edge() {
         // The cut is the midpoint of the longest edge: it is a vertex of both halves, and the
         // longest edge of each half is no longer than the parent's.
         let longest = |t: &Triangle| {
-            (0..3).map(|i| (t.v[(i + 1) % 3] - t.v[i]).length()).fold(0.0, f64::max)
+            (0..3)
+                .map(|i| (t.v[(i + 1) % 3] - t.v[i]).length())
+                .fold(0.0, f64::max)
         };
         let l = longest(&t);
         let mids: Vec<DVec3> = (0..3).map(|i| 0.5 * (t.v[i] + t.v[(i + 1) % 3])).collect();
         let m = a.v[1];
         assert_eq!(m, b.v[0]);
-        let k = mids.iter().position(|&x| x == m).expect("cut at an edge midpoint");
+        let k = mids
+            .iter()
+            .position(|&x| x == m)
+            .expect("cut at an edge midpoint");
         assert!(((t.v[(k + 1) % 3] - t.v[k]).length() - l).abs() <= 1e-15 * l);
         assert!(longest(&a) <= l * (1.0 + 1e-15) && longest(&b) <= l * (1.0 + 1e-15));
     }
@@ -105,7 +110,10 @@ fn refinement_never_loses_or_double_counts_a_triangle() {
         frontier.push(b);
         if step % 100 == 0 || step == 2999 {
             let sum: f64 = frontier.iter().map(|&c| refs.area(&tree, c)).sum();
-            assert!((sum - total).abs() <= 1e-12 * total, "step {step}: {sum} vs {total}");
+            assert!(
+                (sum - total).abs() <= 1e-12 * total,
+                "step {step}: {sum} vs {total}"
+            );
             // Per mesh triangle: the pieces of the frontier that came from it.
             let mut per = vec![0.0; tree.triangles().len()];
             for &c in &frontier {
@@ -125,11 +133,19 @@ fn refinement_never_loses_or_double_counts_a_triangle() {
                 }
             }
             for (t, got) in tree.triangles().iter().zip(&per) {
-                assert!((got - t.area).abs() <= 1e-12 * t.area, "{got} vs {}", t.area);
+                assert!(
+                    (got - t.area).abs() <= 1e-12 * t.area,
+                    "{got} vs {}",
+                    t.area
+                );
             }
         }
     }
-    assert!(refs.splits() > 1000, "the test reaches deep splits: {}", refs.splits());
+    assert!(
+        refs.splits() > 1000,
+        "the test reaches deep splits: {}",
+        refs.splits()
+    );
     // Splitting again (as another triplet of the same pixel would) reuses the same halves.
     let before = refs.splits();
     for (id, halves) in &first_splits {
@@ -162,7 +178,10 @@ fn the_split_cap_holds_and_is_counted() {
     assert!(refs.split(&tree, a).is_some());
     assert_eq!(refs.nodes().len(), 6);
     refs.clear();
-    assert_eq!((refs.splits(), refs.cap_hits(), refs.nodes().len()), (0, 0, 0));
+    assert_eq!(
+        (refs.splits(), refs.cap_hits(), refs.nodes().len()),
+        (0, 0, 0)
+    );
 }
 
 /// Eq. 7: points fall in each triangle in proportion to its area, and uniformly inside it
@@ -193,7 +212,13 @@ fn cluster_sampling_is_uniform_in_area() {
     for _ in 0..n {
         let (p, nrm) = refs.sample(&tree, tree.root(), [u.f(), u.f(), u.f()]);
         assert_eq!(nrm.z.abs(), 1.0);
-        let k = if p.x <= 1.0 { 0 } else if p.x <= 3.0 { 1 } else { 2 };
+        let k = if p.x <= 1.0 {
+            0
+        } else if p.x <= 3.0 {
+            1
+        } else {
+            2
+        };
         count[k] += 1;
         if k == 0 && p.x < p.y {
             left_half += 1;
@@ -220,7 +245,11 @@ fn bad_meshes_are_errors() {
     assert!(IrradianceTree::new(&p, &[[0, 0, 1]]).is_err()); // zero area
     assert!(IrradianceTree::new(&[DVec3::NAN, DVec3::X, DVec3::Y], &[[0, 1, 2]]).is_err());
     assert!(ShadingTree::new(vec![]).is_err());
-    let sp = ShadingPoint { position: DVec3::ZERO, normal: DVec3::Z, weight: -1.0 };
+    let sp = ShadingPoint {
+        position: DVec3::ZERO,
+        normal: DVec3::Z,
+        weight: -1.0,
+    };
     assert!(ShadingTree::new(vec![sp]).is_err());
     assert!(LightTree::new(vec![]).is_err());
     assert!(LightTree::new(vec![Vpl::point(DVec3::ZERO, [1.0, -1.0, 0.0])]).is_err());

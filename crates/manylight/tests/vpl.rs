@@ -46,12 +46,19 @@ fn every_node_sums_boxes_and_cones_its_vpls() {
     let mut all = Vec::new();
     leaves(&tree, tree.root(), &mut all);
     all.sort_unstable();
-    assert_eq!(all, (0..37).collect::<Vec<u32>>(), "each VPL in exactly one leaf");
+    assert_eq!(
+        all,
+        (0..37).collect::<Vec<u32>>(),
+        "each VPL in exactly one leaf"
+    );
     for id in 0..tree.nodes().len() as u32 {
         let node = tree.node(id);
         let mut below = Vec::new();
         leaves(&tree, id, &mut below);
-        let sum: f64 = below.iter().map(|&k| vpls[k as usize].scalar_intensity()).sum();
+        let sum: f64 = below
+            .iter()
+            .map(|&k| vpls[k as usize].scalar_intensity())
+            .sum();
         assert!((node.intensity - sum).abs() <= 1e-12 * sum);
         assert!(below.contains(&node.representative));
         for &k in &below {

@@ -66,14 +66,19 @@ pub fn vpls() -> Vec<Vpl> {
 }
 
 pub fn shading_points() -> Vec<ShadingPoint> {
-    [(0.45, 0.5, 0.3), (0.55, 0.45, 0.2), (0.5, 0.6, 0.25), (0.4, 0.55, 0.25)]
-        .iter()
-        .map(|&(x, y, w)| ShadingPoint {
-            position: DVec3::new(x, y, 0.0),
-            normal: DVec3::Z,
-            weight: w,
-        })
-        .collect()
+    [
+        (0.45, 0.5, 0.3),
+        (0.55, 0.45, 0.2),
+        (0.5, 0.6, 0.25),
+        (0.4, 0.55, 0.25),
+    ]
+    .iter()
+    .map(|&(x, y, w)| ShadingPoint {
+        position: DVec3::new(x, y, 0.0),
+        normal: DVec3::Z,
+        weight: w,
+    })
+    .collect()
 }
 
 /// Light 0 is blocked for irradiance points with x > 0.5 (a grid line, so the quadrature
@@ -150,14 +155,14 @@ pub fn brute_force(m: usize) -> [f64; 3] {
                     continue;
                 }
                 let g = cos_i * cos_y * (1.0 / d2).min(G_MAX) * ft(cos_i);
-                for ch in 0..3 {
-                    e[ch] += y.intensity[ch] * g;
+                for (e, i) in e.iter_mut().zip(y.intensity) {
+                    *e += i * g;
                 }
             }
             for s in &sps {
                 let r = rd((xi - s.position).length());
-                for ch in 0..3 {
-                    out[ch] += s.weight * r[ch] * e[ch] * sub;
+                for ((o, r), e) in out.iter_mut().zip(r).zip(e) {
+                    *o += s.weight * r * e * sub;
                 }
             }
         }
