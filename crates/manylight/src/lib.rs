@@ -26,6 +26,7 @@
 //! * [`estimator`]: the per-pixel loop, its stopping rules, hazards and caps.
 //! * [`confidence`]: the Student-t quantile table (`statrs`).
 //! * [`profile`]: the checked R_d(r) and F_t(cos θ) closures.
+//! * [`summary`]: frame-level counts (pixels at each cap or hazard).
 //!
 //! **Units.** One length unit throughout (positions, `g_max` in 1/length², R_d in
 //! 1/length², areas in length²); intensities in W/sr; the result is in the units of
@@ -76,6 +77,7 @@ pub mod estimator;
 pub mod irradiance_cluster;
 pub mod profile;
 pub mod shading_cluster;
+pub mod summary;
 pub mod vpl;
 
 pub use aabb::{Aabb, Sphere};
@@ -85,6 +87,7 @@ pub use estimator::{Estimator, Interval, PixelEstimate, Settings, Status, Visibi
 pub use irradiance_cluster::{IcId, IrradianceTree, Refinements, Triangle};
 pub use profile::{LUMINANCE, RadialProfile, Transmittance, luminance};
 pub use shading_cluster::{ShadingPoint, ShadingTree};
+pub use summary::Summary;
 pub use vpl::{LightNode, LightTree, NormalCone, Vpl, VplKind};
 
 /// Errors: bad input data or settings, or a model the bounds cannot handle.

@@ -45,6 +45,9 @@ fn fixed_triplet_count_estimates_are_unbiased() {
     let truth = brute_force(128);
     for selection in [Selection::BssrdfAware, Selection::MaxExtent] {
         for (j, runs) in [(1usize, 200_000u64), (40, 4000), (200, 4000)] {
+            if j == 1 && selection == Selection::MaxExtent {
+                continue; // one triplet: no selection was made
+            }
             let mut st = Settings::new(G_MAX);
             st.epsilon = 0.0;
             st.max_triplets = j;
@@ -89,7 +92,7 @@ fn the_interval_covers_the_truth_about_alpha_of_the_time() {
         (Interval::StandardError, 0.92, 0.975),
     ] {
         let mut st = Settings::new(G_MAX);
-        st.epsilon = 0.03;
+        st.epsilon = 0.05;
         st.interval = interval;
         let est = estimator(&s, st);
         let v = vis();
@@ -99,11 +102,11 @@ fn the_interval_covers_the_truth_about_alpha_of_the_time() {
         for seed in 0..n {
             let px = est.estimate(&s.shading, &v, pixel_seed(7, seed));
             assert_eq!(px.status, Status::Converged);
-            assert!(px.delta < 0.03 * px.value);
+            assert!(px.delta < 0.05 * px.value);
             if (px.value - truth).abs() <= px.delta {
                 inside += 1;
             }
-            if (px.value - truth).abs() < 0.03 * truth {
+            if (px.value - truth).abs() < 0.05 * truth {
                 within_eps += 1;
             }
         }
@@ -210,6 +213,26 @@ fn the_split_cap_holds_freezes_triplets_and_is_reported() {
     assert_eq!((px.triplets, px.splits, px.frozen), (7, 5, 7));
     assert_eq!(px.split_cap_hits, 7);
     assert!(px.value > 0.0 && px.value.is_finite());
+    // Shadowed, the same pixel cannot reach min_triplets = 8 before every triplet is frozen:
+    // it stops as Exhausted too, with value 0.
+    let dark = est.estimate(&sp, &|_: DVec3, _: DVec3| false, 1);
+    assert_eq!(
+        (dark.status, dark.triplets, dark.value),
+        (Status::Exhausted, 7, 0.0)
+    );
+    // The frame summary counts each pixel once under each cap it hit.
+    let mut sum = Summary::default();
+    sum.add(&px);
+    let mut other = Summary::default();
+    other.add(&dark);
+    other.add(&est.estimate(&sp, &vis(), 12));
+    sum.merge(&other);
+    assert_eq!(
+        (sum.pixels, sum.exhausted, sum.split_cap, sum.zero),
+        (3, 3, 3, 0)
+    );
+    assert_eq!((sum.triplets, sum.splits), (21, 15));
+    assert_eq!(sum.mean_triplets(), 7.0);
 }
 
 #[test]
