@@ -6,6 +6,19 @@
 //! [ref_eps]` (defaults 64, 1024, 32, 0.02, ε/20). Prints triplets, splits and time per pixel
 //! for both selections, and the fraction of pixels within ε of a reference rendered with the
 //! same method at `ref_eps` (the paper's estimation accuracy).
+//!
+//! Measured on the project machine (2 shared cores, other builds running, so times are noisy),
+//! `… --example selection -- 64 1024 200 EPS 0.001` (8192 triangles, 1024 VPLs, 200 pixels):
+//!
+//! | ε | BSSRDF-aware triplets / ms / within ε | Max-Extent triplets / ms / within ε |
+//! |---|---|---|
+//! | 10 % | 80 / 1.5 / 89.0 % | 540 / 5.3 / 92.5 % |
+//! | 5 % | 190 / 1.5 / 93.5 % | 1214 / 9.1 / 92.5 % |
+//! | 2 % | 709 / 5.1 / 96.0 % | 3542 / 8.1 / 93.5 % |
+//! | 1 % | 1855 / 8.4 / 95.0 % | 8462 / 25.2 / 94.5 % |
+//!
+//! Max-Extent needs 4.6–6.8× the triplets (the paper's Table 3: 1.8–7.7×); with 200 pixels
+//! the accuracy's binomial standard error is about 1.5 points.
 
 use std::time::Instant;
 
