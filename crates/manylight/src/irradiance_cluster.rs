@@ -1,0 +1,416 @@
+//! Irradiance clusters (ICs): a BVH over one translucent mesh's triangles, uniform area
+//! sampling inside a cluster (Nabata & Iwasaki Eq. 7) and the refinement of a single-triangle
+//! cluster by halving its longest edge (§4.3, Fig. 2(d)) in a per-pixel side arena, so the
+//! shared tree is never rebuilt or mutated.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use crate::Error;
+use crate::aabb::Aabb;
+
+/// A triangle with its area and unit geometric normal (from the winding: counter-clockwise seen
+/// from the side the normal points to; the estimator treats that side as outside).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Vertices.
+    pub v: [DVec3; 3],
+    /// Area (½‖(v1 − v0) × (v2 − v0)‖ for mesh triangles; exactly half the parent's for split
+    /// ones, so refinement conserves area bit for bit).
+    pub area: f64,
+    /// Unit normal (zero for a degenerate triangle).
+    pub normal: DVec3,
+}
+
+impl Triangle {
+    /// The triangle `a b c`, with its area and normal.
+    pub fn new(a: DVec3, b: DVec3, c: DVec3) -> Triangle {
+        let n = (b - a).cross(c - a);
+        Triangle {
+            v: [a, b, c],
+            area: 0.5 * n.length(),
+            normal: n.normalize_or_zero(),
+        }
+    }
+
+    /// The box of the vertices.
+    pub fn bbox(&self) -> Aabb {
+        Aabb::of_points(&self.v)
+    }
+
+    /// A uniformly distributed point from two uniforms in [0, 1) (the square-root
+    /// parameterisation; Turk 1990, pbrt 3rd ed. §13.6.5).
+    #[inline]
+    pub fn sample(&self, u1: f64, u2: f64) -> DVec3 {
+        let s = u1.sqrt();
+        let (b0, b1) = (1.0 - s, u2 * s);
+        b0 * self.v[0] + b1 * self.v[1] + (1.0 - b0 - b1) * self.v[2]
+    }
+
+    /// The two halves cut at the midpoint of the longest edge, both with the parent's winding
+    /// and each with exactly half its area.
+    pub fn halve(&self) -> [Triangle; 2] {
+        let len = |i: usize| (self.v[(i + 1) % 3] - self.v[i]).length_squared();
+        let i = (0..3)
+            .max_by(|&a, &b| len(a).total_cmp(&len(b)).then(b.cmp(&a)))
+            .unwrap_or(0);
+        let (p, q, o) = (self.v[i], self.v[(i + 1) % 3], self.v[(i + 2) % 3]);
+        let m = 0.5 * (p + q);
+        let half = 0.5 * self.area;
+        [
+            Triangle {
+                v: [p, m, o],
+                area: half,
+                normal: self.normal,
+            },
+            Triangle {
+                v: [m, q, o],
+                area: half,
+                normal: self.normal,
+            },
+        ]
+    }
+}
+
+/// A node of the [`IrradianceTree`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IcNode {
+    /// Box of the triangles below.
+    pub bbox: Aabb,
+    /// Sum of their areas (A_j of Eq. 7).
+    pub area: f64,
+    /// Children, or `None` for a leaf of one triangle.
+    pub children: Option<[u32; 2]>,
+    /// The triangle of a leaf (index into [`IrradianceTree::triangles`]).
+    pub triangle: u32,
+}
+
+/// A BVH over a mesh's triangles, one triangle per leaf, built top-down by median split of the
+/// centroids along the longest axis. Shared by all pixels (`Send + Sync`); refinement lives in
+/// [`Refinements`].
+#[derive(Clone, Debug)]
+pub struct IrradianceTree {
+    triangles: Vec<Triangle>,
+    nodes: Vec<IcNode>,
+}
+
+/// An irradiance cluster: a node of the shared tree or a triangle of a pixel's refinement arena.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum IcId {
+    /// A node of the [`IrradianceTree`].
+    Base(u32),
+    /// A split triangle in a [`Refinements`] arena.
+    Split(u32),
+}
+
+impl IrradianceTree {
+    /// Builds the BVH of a mesh. Errors: no triangles, an index out of range, a non-finite
+    /// position, or zero total area. Degenerate triangles are kept (area 0: never sampled).
+    pub fn new(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<IrradianceTree, Error> {
+        if triangles.is_empty() {
+            return Err(Error::InvalidInput("mesh without triangles".into()));
+        }
+        if triangles.len() > (1 << 30) {
+            return Err(Error::InvalidInput(format!(
+                "{} triangles (at most 2^30)",
+                triangles.len()
+            )));
+        }
+        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::InvalidInput(format!("vertex {k} is not finite")));
+        }
+        let mut tris = Vec::with_capacity(triangles.len());
+        for (t, idx) in triangles.iter().enumerate() {
+            let mut v = [DVec3::ZERO; 3];
+            for c in 0..3 {
+                v[c] = *positions.get(idx[c] as usize).ok_or_else(|| {
+                    Error::InvalidInput(format!(
+                        "triangle {t} refers to vertex {} of {}",
+                        idx[c],
+                        positions.len()
+                    ))
+                })?;
+            }
+            tris.push(Triangle::new(v[0], v[1], v[2]));
+        }
+        let total: f64 = tris.iter().map(|t| t.area).sum();
+        if !(total.is_finite() && total > 0.0) {
+            return Err(Error::InvalidInput(format!("mesh area {total} is not > 0")));
+        }
+        let centroids: Vec<DVec3> = tris
+            .iter()
+            .map(|t| (t.v[0] + t.v[1] + t.v[2]) / 3.0)
+            .collect();
+        let mut order: Vec<u32> = (0..tris.len() as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * tris.len() - 1);
+        let blank = IcNode {
+            bbox: Aabb::EMPTY,
+            area: 0.0,
+            children: None,
+            triangle: 0,
+        };
+        nodes.push(blank);
+        let mut stack = vec![(0u32, 0usize, tris.len())];
+        let mut post = Vec::new();
+        while let Some((node, lo, hi)) = stack.pop() {
+            let range = &mut order[lo..hi];
+            if range.len() == 1 {
+                let t = &tris[range[0] as usize];
+                nodes[node as usize] = IcNode {
+                    bbox: t.bbox(),
+                    area: t.area,
+                    children: None,
+                    triangle: range[0],
+                };
+                continue;
+            }
+            let e = range
+                .iter()
+                .fold(Aabb::EMPTY, |b, &k| b.grow(centroids[k as usize]))
+                .extent();
+            let axis = if e.x >= e.y && e.x >= e.z {
+                0
+            } else if e.y >= e.z {
+                1
+            } else {
+                2
+            };
+            range.sort_unstable_by(|&p, &q| {
+                centroids[p as usize][axis]
+                    .total_cmp(&centroids[q as usize][axis])
+                    .then(p.cmp(&q))
+            });
+            let mid = lo + range.len() / 2;
+            let (l, r) = (nodes.len() as u32, nodes.len() as u32 + 1);
+            nodes.push(blank);
+            nodes.push(blank);
+            nodes[node as usize].children = Some([l, r]);
+            post.push(node);
+            stack.push((l, lo, mid));
+            stack.push((r, mid, hi));
+        }
+        for &id in post.iter().rev() {
+            let [l, r] = nodes[id as usize].children.expect("inner node");
+            let (a, b) = (nodes[l as usize], nodes[r as usize]);
+            nodes[id as usize] = IcNode {
+                bbox: a.bbox.union(b.bbox),
+                area: a.area + b.area,
+                children: Some([l, r]),
+                triangle: a.triangle,
+            };
+        }
+        Ok(IrradianceTree {
+            triangles: tris,
+            nodes,
+        })
+    }
+
+    /// The mesh triangles.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// All nodes; the root is node 0.
+    pub fn nodes(&self) -> &[IcNode] {
+        &self.nodes
+    }
+
+    /// The root cluster.
+    pub fn root(&self) -> IcId {
+        IcId::Base(0)
+    }
+
+    /// Total mesh area.
+    pub fn area(&self) -> f64 {
+        self.nodes[0].area
+    }
+}
+
+/// One triangle of a [`Refinements`] arena.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SplitNode {
+    /// The (sub-)triangle.
+    pub triangle: Triangle,
+    /// Its box.
+    pub bbox: Aabb,
+    /// Its two halves once split.
+    pub children: Option<[u32; 2]>,
+}
+
+/// Per-pixel refinement of an [`IrradianceTree`]: the halves of split triangles, in a growable
+/// arena. A triangle split once is reused by every triplet that splits it again, so the
+/// clusters of a pixel always tile the mesh: no triangle is lost or counted twice.
+///
+/// **Memory cap.** At most `max_splits` triangle splits per pixel (two arena entries of
+/// about 200 bytes each per split). At the cap a single-triangle cluster stays unsplit, the
+/// event is counted in [`Refinements::cap_hits`], and the estimator refines one of the
+/// triplet's other clusters instead (or freezes the triplet when none can be refined).
+#[derive(Clone, Debug)]
+pub struct Refinements {
+    nodes: Vec<SplitNode>,
+    base_children: HashMap<u32, [u32; 2]>,
+    max_splits: usize,
+    splits: usize,
+    cap_hits: u64,
+}
+
+impl Refinements {
+    /// An empty arena that allows `max_splits` splits.
+    pub fn new(max_splits: usize) -> Refinements {
+        Refinements {
+            nodes: Vec::new(),
+            base_children: HashMap::new(),
+            max_splits,
+            splits: 0,
+            cap_hits: 0,
+        }
+    }
+
+    /// Empties the arena for the next pixel with a new cap (keeps its allocation).
+    pub fn reset(&mut self, max_splits: usize) {
+        self.clear();
+        self.max_splits = max_splits;
+    }
+
+    /// Empties the arena for the next pixel (keeps its allocation).
+    pub fn clear(&mut self) {
+        self.nodes.clear();
+        self.base_children.clear();
+        self.splits = 0;
+        self.cap_hits = 0;
+    }
+
+    /// Triangle splits made so far.
+    pub fn splits(&self) -> usize {
+        self.splits
+    }
+
+    /// Times a split was refused by the cap.
+    pub fn cap_hits(&self) -> u64 {
+        self.cap_hits
+    }
+
+    /// The arena's triangles.
+    pub fn nodes(&self) -> &[SplitNode] {
+        &self.nodes
+    }
+
+    /// Area A_j of a cluster.
+    pub fn area(&self, tree: &IrradianceTree, id: IcId) -> f64 {
+        match id {
+            IcId::Base(n) => tree.nodes[n as usize].area,
+            IcId::Split(k) => self.nodes[k as usize].triangle.area,
+        }
+    }
+
+    /// Box of a cluster.
+    pub fn bbox(&self, tree: &IrradianceTree, id: IcId) -> Aabb {
+        match id {
+            IcId::Base(n) => tree.nodes[n as usize].bbox,
+            IcId::Split(k) => self.nodes[k as usize].bbox,
+        }
+    }
+
+    /// True if the cluster is one triangle (a BVH leaf or an arena triangle).
+    pub fn is_single_triangle(&self, tree: &IrradianceTree, id: IcId) -> bool {
+        match id {
+            IcId::Base(n) => tree.nodes[n as usize].children.is_none(),
+            IcId::Split(_) => true,
+        }
+    }
+
+    /// True if [`Refinements::split`] would succeed without a new split (an inner BVH node, or
+    /// a triangle split before) or with one under the cap.
+    pub fn can_split(&self, tree: &IrradianceTree, id: IcId) -> bool {
+        match id {
+            IcId::Base(n) => {
+                tree.nodes[n as usize].children.is_some()
+                    || self.base_children.contains_key(&n)
+                    || self.splits < self.max_splits
+            }
+            IcId::Split(k) => {
+                self.nodes[k as usize].children.is_some() || self.splits < self.max_splits
+            }
+        }
+    }
+
+    /// The two halves of a cluster: the BVH children of an inner node, or the two triangles
+    /// from halving the longest edge of a single triangle (made once, then reused). `None` when
+    /// a new split is needed and the cap is reached (counted in [`Refinements::cap_hits`]).
+    pub fn split(&mut self, tree: &IrradianceTree, id: IcId) -> Option<[IcId; 2]> {
+        match id {
+            IcId::Base(n) => {
+                let node = &tree.nodes[n as usize];
+                if let Some([a, b]) = node.children {
+                    return Some([IcId::Base(a), IcId::Base(b)]);
+                }
+                if let Some(&[a, b]) = self.base_children.get(&n) {
+                    return Some([IcId::Split(a), IcId::Split(b)]);
+                }
+                let t = tree.triangles[node.triangle as usize];
+                let [a, b] = self.push_halves(&t)?;
+                self.base_children.insert(n, [a, b]);
+                Some([IcId::Split(a), IcId::Split(b)])
+            }
+            IcId::Split(k) => {
+                if let Some([a, b]) = self.nodes[k as usize].children {
+                    return Some([IcId::Split(a), IcId::Split(b)]);
+                }
+                let t = self.nodes[k as usize].triangle;
+                let [a, b] = self.push_halves(&t)?;
+                self.nodes[k as usize].children = Some([a, b]);
+                Some([IcId::Split(a), IcId::Split(b)])
+            }
+        }
+    }
+
+    fn push_halves(&mut self, t: &Triangle) -> Option<[u32; 2]> {
+        if self.splits >= self.max_splits {
+            self.cap_hits += 1;
+            return None;
+        }
+        self.splits += 1;
+        let a = self.nodes.len() as u32;
+        for h in t.halve() {
+            self.nodes.push(SplitNode {
+                triangle: h,
+                bbox: h.bbox(),
+                children: None,
+            });
+        }
+        Some([a, a + 1])
+    }
+
+    /// Samples a point uniformly (density 1/A_j, Eq. 7) in a cluster from three uniforms:
+    /// a triangle in proportion to area (descending the BVH), then a uniform point on it.
+    /// Returns the point and the triangle's normal.
+    pub fn sample(&self, tree: &IrradianceTree, id: IcId, u: [f64; 3]) -> (DVec3, DVec3) {
+        let tri = match id {
+            IcId::Split(k) => &self.nodes[k as usize].triangle,
+            IcId::Base(mut n) => {
+                let mut u0 = u[0];
+                loop {
+                    let node = &tree.nodes[n as usize];
+                    let Some([a, b]) = node.children else {
+                        break &tree.triangles[node.triangle as usize];
+                    };
+                    let (wa, wb) = (tree.nodes[a as usize].area, tree.nodes[b as usize].area);
+                    let pa = if wa + wb > 0.0 { wa / (wa + wb) } else { 1.0 };
+                    if u0 < pa || wb <= 0.0 {
+                        u0 = if pa > 0.0 {
+                            (u0 / pa).min(1.0 - f64::EPSILON)
+                        } else {
+                            0.0
+                        };
+                        n = a;
+                    } else {
+                        u0 = ((u0 - pa) / (1.0 - pa)).clamp(0.0, 1.0 - f64::EPSILON);
+                        n = b;
+                    }
+                }
+            }
+        };
+        (tri.sample(u[1], u[2]), tri.normal)
+    }
+}

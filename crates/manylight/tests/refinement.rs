@@ -1,0 +1,257 @@
+//! Irradiance clusters: longest-edge halving conserves area, refinement tiles the mesh (no
+//! triangle lost or counted twice), the split cap holds, and sampling is uniform in area
+//! (Eq. 7).
+
+use glam::DVec3;
+use sss_manylight::*;
+use std::collections::HashMap;
+
+/// A deterministic uniform stream (SplitMix64) for the tests.
+struct U(u64);
+impl U {
+    fn f(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        (sss_util::splitmix64_mix(self.0) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn cross_area(t: &Triangle) -> f64 {
+    0.5 * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).length()
+}
+
+#[test]
+fn halving_conserves_area_and_halves_the_longest_edge() {
+    let mut u = U(1);
+    for _ in 0..1000 {
+        let p: [DVec3; 3] = std::array::from_fn(|_| DVec3::new(u.f(), u.f(), u.f()) * 3.0 - 1.0);
+        let t = Triangle::new(p[0], p[1], p[2]);
+        assert!((t.area - cross_area(&t)).abs() <= 1e-15 * (1.0 + t.area));
+        let [a, b] = t.halve();
+        // Stored areas: exactly half each, so sums are exact.
+        assert_eq!(a.area + b.area, t.area);
+        // Geometric areas agree with the stored ones to rounding.
+        for h in [a, b] {
+            assert!((cross_area(&h) - 0.5 * t.area).abs() <= 1e-12 * (1.0 + t.area));
+            // Same orientation as the parent.
+            let n = (h.v[1] - h.v[0]).cross(h.v[2] - h.v[0]);
+            assert!(n.dot(t.normal) >= 0.0);
+        }
+        // The cut is the midpoint of the longest edge: it is a vertex of both halves, and the
+        // longest edge of each half is no longer than the parent's.
+        let longest = |t: &Triangle| {
+            (0..3)
+                .map(|i| (t.v[(i + 1) % 3] - t.v[i]).length())
+                .fold(0.0, f64::max)
+        };
+        let l = longest(&t);
+        let mids: Vec<DVec3> = (0..3).map(|i| 0.5 * (t.v[i] + t.v[(i + 1) % 3])).collect();
+        let m = a.v[1];
+        assert_eq!(m, b.v[0]);
+        let k = mids
+            .iter()
+            .position(|&x| x == m)
+            .expect("cut at an edge midpoint");
+        assert!(((t.v[(k + 1) % 3] - t.v[k]).length() - l).abs() <= 1e-15 * l);
+        assert!(longest(&a) <= l * (1.0 + 1e-15) && longest(&b) <= l * (1.0 + 1e-15));
+    }
+}
+
+/// A random frontier of clusters that starts at the root; a random member is repeatedly
+/// replaced by its two halves (BVH children or triangle halves). Every frontier must tile the
+/// mesh: its areas sum to the mesh area, and per original triangle the split pieces sum to its
+/// area. A second frontier splitting the same clusters gets the same arena ids (splits are
+/// reused, never duplicated).
+#[test]
+fn refinement_never_loses_or_double_counts_a_triangle() {
+    // A 6 × 6 grid of a bumpy height field: 72 triangles of different areas.
+    let n = 6;
+    let mut pos = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            pos.push(DVec3::new(x, y, 0.2 * (5.0 * x).sin() * (3.0 * y).cos()));
+        }
+    }
+    let mut tris = Vec::new();
+    for j in 0..n as u32 {
+        for i in 0..n as u32 {
+            let a = j * (n as u32 + 1) + i;
+            let w = n as u32 + 1;
+            tris.push([a, a + 1, a + w + 1]);
+            tris.push([a, a + w + 1, a + w]);
+        }
+    }
+    let tree = IrradianceTree::new(&pos, &tris).unwrap();
+    let total: f64 = tree.triangles().iter().map(|t| t.area).sum();
+    assert!((tree.area() - total).abs() <= 1e-12 * total);
+
+    let mut refs = Refinements::new(10_000);
+    let mut origin: HashMap<IcId, u32> = HashMap::new(); // arena cluster -> mesh triangle
+    let mut frontier = vec![tree.root()];
+    let mut u = U(7);
+    let mut first_splits: Vec<(IcId, [IcId; 2])> = Vec::new();
+    for step in 0..3000 {
+        let k = (u.f() * frontier.len() as f64) as usize;
+        let id = frontier.swap_remove(k);
+        let [a, b] = refs.split(&tree, id).expect("under the cap");
+        if let IcId::Base(nid) = id
+            && tree.nodes()[nid as usize].children.is_none()
+        {
+            origin.insert(a, tree.nodes()[nid as usize].triangle);
+            origin.insert(b, tree.nodes()[nid as usize].triangle);
+        }
+        if let IcId::Split(_) = id {
+            let o = origin[&id];
+            origin.insert(a, o);
+            origin.insert(b, o);
+        }
+        first_splits.push((id, [a, b]));
+        frontier.push(a);
+        frontier.push(b);
+        if step % 100 == 0 || step == 2999 {
+            let sum: f64 = frontier.iter().map(|&c| refs.area(&tree, c)).sum();
+            assert!(
+                (sum - total).abs() <= 1e-12 * total,
+                "step {step}: {sum} vs {total}"
+            );
+            // Per mesh triangle: the pieces of the frontier that came from it.
+            let mut per = vec![0.0; tree.triangles().len()];
+            for &c in &frontier {
+                match c {
+                    IcId::Split(_) => per[origin[&c] as usize] += refs.area(&tree, c),
+                    IcId::Base(nid) => {
+                        // Every mesh triangle below this BVH node, whole.
+                        let mut stack = vec![nid];
+                        while let Some(m) = stack.pop() {
+                            let node = tree.nodes()[m as usize];
+                            match node.children {
+                                Some([x, y]) => stack.extend([x, y]),
+                                None => per[node.triangle as usize] += node.area,
+                            }
+                        }
+                    }
+                }
+            }
+            for (t, got) in tree.triangles().iter().zip(&per) {
+                assert!(
+                    (got - t.area).abs() <= 1e-12 * t.area,
+                    "{got} vs {}",
+                    t.area
+                );
+            }
+        }
+    }
+    assert!(
+        refs.splits() > 1000,
+        "the test reaches deep splits: {}",
+        refs.splits()
+    );
+    // Splitting again (as another triplet of the same pixel would) reuses the same halves.
+    let before = refs.splits();
+    for (id, halves) in &first_splits {
+        assert_eq!(refs.split(&tree, *id), Some(*halves));
+    }
+    assert_eq!(refs.splits(), before);
+    // Arena triangles' boxes contain their vertices and lie in their parents' boxes.
+    for node in refs.nodes() {
+        for v in node.triangle.v {
+            assert!(node.bbox.contains(v));
+        }
+    }
+}
+
+#[test]
+fn the_split_cap_holds_and_is_counted() {
+    let pos = [DVec3::ZERO, DVec3::X, DVec3::Y];
+    let tree = IrradianceTree::new(&pos, &[[0, 1, 2]]).unwrap();
+    let mut refs = Refinements::new(3);
+    let [a, _] = refs.split(&tree, tree.root()).unwrap();
+    let [c, _] = refs.split(&tree, a).unwrap();
+    let [e, f] = refs.split(&tree, c).unwrap();
+    assert_eq!(refs.splits(), 3);
+    assert!(!refs.can_split(&tree, e));
+    assert_eq!(refs.split(&tree, e), None);
+    assert_eq!(refs.split(&tree, f), None);
+    assert_eq!(refs.cap_hits(), 2);
+    // Already-split clusters still return their halves at the cap.
+    assert!(refs.can_split(&tree, a));
+    assert!(refs.split(&tree, a).is_some());
+    assert_eq!(refs.nodes().len(), 6);
+    refs.clear();
+    assert_eq!(
+        (refs.splits(), refs.cap_hits(), refs.nodes().len()),
+        (0, 0, 0)
+    );
+}
+
+/// Eq. 7: points fall in each triangle in proportion to its area, and uniformly inside it
+/// (the fraction in the half of a triangle cut at an edge midpoint is ½). Binomial margins of 5
+/// standard errors.
+#[test]
+fn cluster_sampling_is_uniform_in_area() {
+    // Three triangles of areas 0.5, 0.75 and 0.25 (all in z = 0).
+    let pos = [
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Y,
+        DVec3::new(2.0, 0.0, 0.0),
+        DVec3::new(2.0, 1.5, 0.0),
+        DVec3::new(3.0, 0.0, 0.0),
+        DVec3::new(3.0, 0.5, 0.0),
+        DVec3::new(4.0, 0.0, 0.0),
+    ];
+    let tris = [[0, 1, 2], [3, 5, 4], [5, 7, 6]];
+    let tree = IrradianceTree::new(&pos, &tris).unwrap();
+    let areas: Vec<f64> = tree.triangles().iter().map(|t| t.area).collect();
+    assert_eq!(areas, vec![0.5, 0.75, 0.25]);
+    let refs = Refinements::new(0);
+    let mut u = U(3);
+    let n = 200_000;
+    let mut count = [0usize; 3];
+    let mut left_half = 0usize;
+    for _ in 0..n {
+        let (p, nrm) = refs.sample(&tree, tree.root(), [u.f(), u.f(), u.f()]);
+        assert_eq!(nrm.z.abs(), 1.0);
+        let k = if p.x <= 1.0 {
+            0
+        } else if p.x <= 3.0 {
+            1
+        } else {
+            2
+        };
+        count[k] += 1;
+        if k == 0 && p.x < p.y {
+            left_half += 1;
+        }
+    }
+    let total = 1.5;
+    for k in 0..3 {
+        let pk = areas[k] / total;
+        let se = (pk * (1.0 - pk) / n as f64).sqrt();
+        let got = count[k] as f64 / n as f64;
+        assert!((got - pk).abs() < 5.0 * se, "triangle {k}: {got} vs {pk}");
+    }
+    // Inside triangle 0 the line x = y splits the area in two halves.
+    let se = (0.25 / count[0] as f64).sqrt();
+    let got = left_half as f64 / count[0] as f64;
+    assert!((got - 0.5).abs() < 5.0 * se, "{got}");
+}
+
+#[test]
+fn bad_meshes_are_errors() {
+    let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+    assert!(IrradianceTree::new(&p, &[]).is_err());
+    assert!(IrradianceTree::new(&p, &[[0, 1, 3]]).is_err());
+    assert!(IrradianceTree::new(&p, &[[0, 0, 1]]).is_err()); // zero area
+    assert!(IrradianceTree::new(&[DVec3::NAN, DVec3::X, DVec3::Y], &[[0, 1, 2]]).is_err());
+    assert!(ShadingTree::new(vec![]).is_err());
+    let sp = ShadingPoint {
+        position: DVec3::ZERO,
+        normal: DVec3::Z,
+        weight: -1.0,
+    };
+    assert!(ShadingTree::new(vec![sp]).is_err());
+    assert!(LightTree::new(vec![]).is_err());
+    assert!(LightTree::new(vec![Vpl::point(DVec3::ZERO, [1.0, -1.0, 0.0])]).is_err());
+    assert!(LightTree::new(vec![Vpl::oriented(DVec3::ZERO, DVec3::ZERO, [1.0; 3])]).is_err());
+}
