@@ -26,13 +26,17 @@ pub enum Error {
     /// A model produced a value that is not a finite number (exit code 1): a bug in the model,
     /// reported instead of printed.
     NonFinite(String),
+    /// The method cannot render this scene as asked (exit code 2), e.g. a method that sums
+    /// R_d·E·A over clusters on a material with the directional dipole. `compare` skips such
+    /// method–scene pairs and lists them.
+    Unsupported(String),
 }
 
 impl Error {
     /// The process exit code for this error: 2 for bad input, 1 for failures while running.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Input(_) | Error::Bssrdf(_) => 2,
+            Error::Input(_) | Error::Bssrdf(_) | Error::Unsupported(_) => 2,
             Error::Scene(e) if e.kind == SceneErrorKind::Io => 1,
             Error::Scene(_) => 2,
             Error::Io { .. } | Error::NonFinite(_) => 1,
@@ -43,7 +47,7 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Error::Input(msg) | Error::NonFinite(msg) => f.write_str(msg),
+            Error::Input(msg) | Error::NonFinite(msg) | Error::Unsupported(msg) => f.write_str(msg),
             Error::Bssrdf(e) => write!(f, "{e}"),
             Error::Scene(e) => write!(f, "{e}"),
             Error::Io { what, source } => write!(f, "{what}: {source}"),

@@ -101,7 +101,7 @@ impl TranslucentShading {
     /// R_d · E · A (trees, many-light, separable kernels), which the directional dipole is not.
     pub fn radial(&self, method: &str) -> Result<&dyn Bssrdf, crate::Error> {
         self.model.radial().ok_or_else(|| {
-            crate::Error::Input(format!(
+            crate::Error::Unsupported(format!(
                 "material `{}`: method {method} needs a radial model, but `{}` is the directional \
                  dipole, whose S depends on the incident direction (use exact or pathtrace, or \
                  another model)",

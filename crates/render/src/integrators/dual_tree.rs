@@ -412,6 +412,7 @@ impl Integrator for DualTree {
         });
         let counts = Counts::default();
         let mut values = vec![[0.0; 3]; frame.gbuffer.samples.len()];
+        let mut shaded_points = 0u64;
         frame.timed("shading", || {
             for &o in &frame.visible {
                 let (Some(sh), Some(irr), Some(px), Some((pts, index))) = (
@@ -424,6 +425,7 @@ impl Integrator for DualTree {
                 };
                 let ordered: Vec<PixelPoint> =
                     px.tree.order.iter().map(|&k| pts[k as usize]).collect();
+                shaded_points += ordered.len() as u64;
                 let mut acc = vec![[0.0; 3]; ordered.len()];
                 if !irr.tree.nodes.is_empty() {
                     let dual = Dual {
@@ -461,6 +463,9 @@ impl Integrator for DualTree {
                 }
             }
         });
+        // Progress counts every G-buffer sample once: the ones no tree shaded (opaque surfaces,
+        // background objects) now.
+        progress.advance(frame.gbuffer.samples.len() as u64 - shaded_points);
         let mut stats = counts.stats("node_pairs_visited");
         let rates: Vec<f64> = points
             .iter()

@@ -21,7 +21,7 @@ pub(super) use load::load_scenes;
 use super::output::{md_num, md_pct, md_table, write_atomic};
 use super::{Context, Error, Experiment, Section};
 use images::write_images;
-use runs::{Run, csv_rows, run_timed};
+use runs::{Outcome, Run, csv_rows, run_timed};
 use sss_plot::{PALETTE, Series, SeriesStyle, line_plot};
 use sss_render::image::{auto_exposure, write_png};
 use sss_render::integrators::{METHODS, MethodOptions};
@@ -55,6 +55,7 @@ impl Experiment for SceneComparison {
         let mut runs: Vec<Run> = Vec::new();
         let mut body = String::new();
         let mut summary_rows = Vec::new();
+        let mut unsupported: Vec<String> = Vec::new();
         for (scene, text) in &scenes {
             let reference = reference(ctx, scene, text)?;
             let pixels: Vec<usize> = (0..reference.coverage.len())
@@ -82,7 +83,7 @@ impl Experiment for SceneComparison {
             )
             .map_err(e)?;
             let mut series = Vec::new();
-            for (mi, m) in METHODS.iter().enumerate() {
+            'methods: for (mi, m) in METHODS.iter().enumerate() {
                 let values = (m.sweep.values)(cfg.quick);
                 let mut points = Vec::new();
                 for (vi, &v) in values.iter().enumerate() {
@@ -94,7 +95,14 @@ impl Experiment for SceneComparison {
                         ));
                         let method = (m.build)(&MethodOptions::new().with(m.sweep.option, v))
                             .map_err(|e| Error(format!("{label}: {e}")))?;
-                        let out = run_timed(method.as_ref(), scene, &settings, threads, &label)?;
+                        let out = match run_timed(method.as_ref(), scene, &settings, threads, &label)? {
+                            Outcome::Done(out) => out,
+                            Outcome::Unsupported(why) => {
+                                (ctx.log)(&format!("scene {}: {} skipped: {why}", scene.name, m.name));
+                                unsupported.push(format!("`{}` on `{}`: {why}", m.name, scene.name));
+                                continue 'methods;
+                            }
+                        };
                         for w in &out.warnings {
                             (ctx.log)(&format!("scene {}: {label}: warning: {w}", scene.name));
                         }
@@ -241,6 +249,12 @@ impl Experiment for SceneComparison {
         );
         for s in &skipped {
             let _ = writeln!(summary, "\nSkipped {s}");
+        }
+        if !unsupported.is_empty() {
+            let _ = writeln!(summary, "\nMethods that cannot render a scene (not run there):\n");
+            for u in &unsupported {
+                let _ = writeln!(summary, "- {u}");
+            }
         }
         let mut warned: Vec<String> = Vec::new();
         for r in runs.iter().filter(|r| !r.warnings.is_empty()) {

@@ -109,6 +109,14 @@ pub fn csv_rows(runs: &[Run]) -> String {
     s
 }
 
+/// What one run gave.
+pub enum Outcome {
+    /// The render.
+    Done(Box<RenderOutput>),
+    /// The method cannot render this scene (why): the run is skipped and listed.
+    Unsupported(String),
+}
+
 /// Renders `scene` with `method` on a pool of `threads` threads; errors name the scene and the
 /// run (`label`).
 pub fn run_timed(
@@ -117,13 +125,16 @@ pub fn run_timed(
     settings: &RenderSettings,
     threads: usize,
     label: &str,
-) -> Result<RenderOutput, Error> {
+) -> Result<Outcome, Error> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| Error(format!("cannot start {threads} threads: {e}")))?;
-    pool.install(|| render(scene, method, settings, &NoProgress))
-        .map_err(|e| Error(format!("scene {}: {label}: {e}", scene.name)))
+    match pool.install(|| render(scene, method, settings, &NoProgress)) {
+        Ok(out) => Ok(Outcome::Done(Box::new(out))),
+        Err(sss_render::Error::Unsupported(why)) => Ok(Outcome::Unsupported(why)),
+        Err(e) => Err(Error(format!("scene {}: {label}: {e}", scene.name))),
+    }
 }
 
 #[cfg(test)]

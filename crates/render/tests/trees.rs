@@ -1,0 +1,192 @@
+//! The single-tree (Jensen & Buhler 2002) and dual-tree (Milaenen et al. 2019) integrators
+//! against `exact` over the same irradiance samples: equal to rounding when nothing is
+//! clustered (ε → 0, and ρ → 0 for the dual tree), a bounded error that shrinks with ε, pixel
+//! clusters that do not make the dual tree worse than shading every pixel, and the directional
+//! dipole refused with an error naming the material.
+
+use sss_bssrdf::Rgb;
+use sss_render::frame::Frame;
+use sss_render::integrators::dual_tree::DualTree;
+use sss_render::integrators::exact::Exact;
+use sss_render::integrators::single_tree::SingleTree;
+use sss_render::integrators::{Integrator, Shaded};
+use sss_render::irradiance::IrradianceSettings;
+use sss_render::progress::NoProgress;
+use sss_render::scene::{LoadOptions, Scene, builtin};
+
+fn scene(name: &str, w: u32, h: u32) -> Scene {
+    let mut s = builtin(name, &LoadOptions::default()).unwrap();
+    s.camera.width = w;
+    s.camera.height = h;
+    s
+}
+
+fn irradiance(spacing: f64) -> IrradianceSettings {
+    IrradianceSettings {
+        spacing_mfp: spacing,
+        ..IrradianceSettings::default()
+    }
+}
+
+fn run(frame: &Frame<'_>, m: &dyn Integrator) -> Shaded {
+    m.integrate(frame, &NoProgress).unwrap()
+}
+
+/// Largest relative difference per G-buffer sample and channel (relative to the largest value
+/// of the reference, so dark samples do not dominate), and the relative RMSE over samples.
+fn errors(a: &[Rgb], reference: &[Rgb]) -> (f64, f64) {
+    let scale = reference.iter().flatten().fold(0.0f64, |m, &x| m.max(x));
+    assert!(scale > 0.0);
+    let (mut worst, mut se, mut sr, mut n) = (0.0f64, 0.0, 0.0, 0.0);
+    for (x, r) in a.iter().zip(reference) {
+        for c in 0..3 {
+            worst = worst.max((x[c] - r[c]).abs() / scale);
+            se += (x[c] - r[c]).powi(2);
+            sr += r[c].powi(2);
+            n += 1.0;
+        }
+    }
+    assert!(n > 0.0);
+    (worst, (se / sr).sqrt())
+}
+
+#[test]
+fn trees_equal_exact_when_nothing_is_clustered() {
+    // Sphere (better dipole) and slab (standard dipole): every pair reaches the leaves and the
+    // leaves sum sample by sample, so only the summation order differs.
+    for (name, w, h) in [("sphere", 48, 36), ("slab", 40, 30)] {
+        let s = scene(name, w, h);
+        let frame = Frame::prepare(&s, 1);
+        let irr = irradiance(1.5);
+        let exact = run(&frame, &Exact { irradiance: irr });
+        let single = run(&frame, &SingleTree { irradiance: irr, eps: 0.0 });
+        let dual = run(
+            &frame,
+            &DualTree {
+                irradiance: irr,
+                eps: 0.0,
+                rho: 0.0,
+            },
+        );
+        let (w1, _) = errors(&single.values, &exact.values);
+        let (w2, _) = errors(&dual.values, &exact.values);
+        assert!(w1 < 1e-12, "{name}: single tree differs by {w1:e}");
+        assert!(w2 < 1e-12, "{name}: dual tree differs by {w2:e}");
+    }
+}
+
+#[test]
+fn tree_error_is_small_and_shrinks_with_eps() {
+    let s = scene("sphere", 64, 48);
+    let frame = Frame::prepare(&s, 1);
+    let irr = irradiance(1.0);
+    let exact = run(&frame, &Exact { irradiance: irr });
+    let mut last_single = f64::INFINITY;
+    // Measured relative RMSE against exact on this frame (single / dual at ρ = 0.75):
+    // ε = 0.2: 1.7 % / 2.3 %; 0.05: 0.19 % / 0.24 %; 0.01: 0.0033 % / 0.0038 %. Pinned at
+    // about twice the larger (a bug that loses or double-counts a node is far above these).
+    for (eps, bound) in [(0.2, 0.045), (0.05, 0.005), (0.01, 8e-5)] {
+        let single = run(&frame, &SingleTree { irradiance: irr, eps });
+        let dual = run(
+            &frame,
+            &DualTree {
+                irradiance: irr,
+                eps,
+                rho: 0.75,
+            },
+        );
+        let (_, e1) = errors(&single.values, &exact.values);
+        let (_, e2) = errors(&dual.values, &exact.values);
+        println!("eps {eps}: single {e1:.4e}, dual {e2:.4e}");
+        assert!(e1 < bound, "single tree at ε = {eps}: {e1}");
+        assert!(e2 < bound, "dual tree at ε = {eps}: {e2}");
+        assert!(e1 < last_single, "single tree error grew as ε shrank");
+        last_single = e1;
+    }
+}
+
+#[test]
+fn shading_every_pixel_is_no_worse_than_pixel_clusters() {
+    // A frame large enough that s_p < 1, so ρ = 0.75 clusters pixels (P = ρ / max s_p > 1).
+    let s = scene("sphere", 320, 240);
+    let frame = Frame::prepare(&s, 1);
+    let irr = irradiance(2.0);
+    let exact = run(&frame, &Exact { irradiance: irr });
+    let at = |rho| {
+        run(
+            &frame,
+            &DualTree {
+                irradiance: irr,
+                eps: 0.05,
+                rho,
+            },
+        )
+    };
+    let clustered = at(0.75);
+    let every = at(0.0);
+    let coarse = at(8.0);
+    let (_, e_clustered) = errors(&clustered.values, &exact.values);
+    let (_, e_every) = errors(&every.values, &exact.values);
+    let (_, e_coarse) = errors(&coarse.values, &exact.values);
+    // Measured: ρ = 0: 0.027 %, 0.75: 1.9 %, 8: 3.6 % (the point sum `exact` has per-pixel
+    // structure from its nearest samples that pixel clusters average out).
+    println!("rho 0: {e_every:.4e}, 0.75: {e_clustered:.4e}, 8: {e_coarse:.4e}");
+    assert!(e_every < 1e-3 && e_clustered < 0.04 && e_coarse < 0.07);
+    assert!(e_every <= e_clustered * (1.0 + 1e-9));
+    assert!(e_clustered <= e_coarse);
+    // Clustering pixels must do less work than shading each one.
+    let evals = |s: &Shaded| {
+        s.stats
+            .iter()
+            .filter(|x| x.name.ends_with("evaluations"))
+            .map(|x| x.value)
+            .sum::<f64>()
+    };
+    assert!(
+        evals(&clustered) < 0.9 * evals(&every),
+        "{} vs {}",
+        evals(&clustered),
+        evals(&every)
+    );
+    // ρ = 0 shades every sample by itself: the same work as the single tree at that ε would
+    // do is not required, but the result must be close to it (same ε, different Δω origin).
+    let single = run(&frame, &SingleTree { irradiance: irr, eps: 0.05 });
+    let (_, e_single) = errors(&single.values, &exact.values);
+    assert!(e_every < 2.0 * e_single + 1e-3, "{e_every} vs {e_single}");
+}
+
+#[test]
+fn trees_refuse_the_directional_dipole_naming_the_material() {
+    let s = scene("toad", 32, 24);
+    let frame = Frame::prepare(&s, 1);
+    let methods: [Box<dyn Integrator>; 2] =
+        [Box::new(SingleTree::default()), Box::new(DualTree::default())];
+    for m in methods {
+        let e = m.integrate(&frame, &NoProgress).unwrap_err();
+        assert!(matches!(e, sss_render::Error::Unsupported(_)), "{e}");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("directional dipole") && msg.contains(m.name()),
+            "{msg}"
+        );
+    }
+}
+
+#[test]
+fn tree_structures_count_against_the_memory_budget() {
+    use sss_render::render::{RenderSettings, render};
+    let s = scene("sphere", 1600, 1200);
+    let exact_need = {
+        let est = sss_render::budget::irradiance_estimate(&s, &irradiance(0.5));
+        est.iter().map(|e| e.2).sum::<u64>()
+            + sss_render::budget::frame_bytes(1600, 1200, s.camera.pixel_samples)
+    };
+    // A budget that fits the frame and the samples but not the pixel tree over 1.9 M points.
+    let settings = RenderSettings {
+        max_memory: exact_need + (8 << 20),
+        ..RenderSettings::default()
+    };
+    let err = render(&s, &DualTree::default(), &settings, &NoProgress).unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("structures") && msg.contains("--max-memory"), "{msg}");
+}
