@@ -101,6 +101,11 @@ struct CompareArgs {
     /// Directory to search for meshes (repeatable) [default: SSS_MESH_DIR, ../shared/meshes].
     #[arg(long, value_name = "DIR")]
     mesh_dir: Vec<PathBuf>,
+    /// Run only the paper-scale tree experiments (Milaenen et al. 2019 on the full-resolution
+    /// bunny from the shared meshes, 256² to 2048²; about 20–30 minutes on 2 cores, a few
+    /// with --quick) instead of the default experiments.
+    #[arg(long)]
+    trees: bool,
 }
 
 fn workspace_root() -> PathBuf {
@@ -217,6 +222,7 @@ fn main() -> ExitCode {
                     args.mesh_dir
                 },
                 quick: args.quick,
+                trees: args.trees,
             };
             compare::run(&config)
         }

@@ -5,6 +5,7 @@
 //! model request, the transmitted irradiance and exit weight).
 
 use glam::DVec3;
+use sss_bssrdf::ModelKind;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::fresnel_normalization;
 use sss_render::frame::Frame;
@@ -13,7 +14,6 @@ use sss_render::irradiance::IrradianceSettings;
 use sss_render::lights::Incident;
 use sss_render::progress::{NoProgress, Progress};
 use sss_render::render::{RenderSettings, render};
-use sss_bssrdf::ModelKind;
 use sss_render::scene::{LoadOptions, MaterialKind, Scene, builtin};
 use sss_render::shading::transmitted_irradiance;
 use std::f64::consts::PI;

@@ -59,7 +59,13 @@ fn trees_equal_exact_when_nothing_is_clustered() {
         let frame = Frame::prepare(&s, 1);
         let irr = irradiance(1.5);
         let exact = run(&frame, &Exact { irradiance: irr });
-        let single = run(&frame, &SingleTree { irradiance: irr, eps: 0.0 });
+        let single = run(
+            &frame,
+            &SingleTree {
+                irradiance: irr,
+                eps: 0.0,
+            },
+        );
         let dual = run(
             &frame,
             &DualTree {
@@ -86,7 +92,13 @@ fn tree_error_is_small_and_shrinks_with_eps() {
     // ε = 0.2: 1.7 % / 2.3 %; 0.05: 0.19 % / 0.24 %; 0.01: 0.0033 % / 0.0038 %. Pinned at
     // about twice the larger (a bug that loses or double-counts a node is far above these).
     for (eps, bound) in [(0.2, 0.045), (0.05, 0.005), (0.01, 8e-5)] {
-        let single = run(&frame, &SingleTree { irradiance: irr, eps });
+        let single = run(
+            &frame,
+            &SingleTree {
+                irradiance: irr,
+                eps,
+            },
+        );
         let dual = run(
             &frame,
             &DualTree {
@@ -150,7 +162,13 @@ fn shading_every_pixel_is_no_worse_than_pixel_clusters() {
     );
     // ρ = 0 shades every sample by itself: the same work as the single tree at that ε would
     // do is not required, but the result must be close to it (same ε, different Δω origin).
-    let single = run(&frame, &SingleTree { irradiance: irr, eps: 0.05 });
+    let single = run(
+        &frame,
+        &SingleTree {
+            irradiance: irr,
+            eps: 0.05,
+        },
+    );
     let (_, e_single) = errors(&single.values, &exact.values);
     assert!(e_every < 2.0 * e_single + 1e-3, "{e_every} vs {e_single}");
 }
@@ -159,8 +177,10 @@ fn shading_every_pixel_is_no_worse_than_pixel_clusters() {
 fn trees_refuse_the_directional_dipole_naming_the_material() {
     let s = scene("toad", 32, 24);
     let frame = Frame::prepare(&s, 1);
-    let methods: [Box<dyn Integrator>; 2] =
-        [Box::new(SingleTree::default()), Box::new(DualTree::default())];
+    let methods: [Box<dyn Integrator>; 2] = [
+        Box::new(SingleTree::default()),
+        Box::new(DualTree::default()),
+    ];
     for m in methods {
         let e = m.integrate(&frame, &NoProgress).unwrap_err();
         assert!(matches!(e, sss_render::Error::Unsupported(_)), "{e}");
@@ -188,5 +208,8 @@ fn tree_structures_count_against_the_memory_budget() {
     };
     let err = render(&s, &DualTree::default(), &settings, &NoProgress).unwrap_err();
     let msg = err.to_string();
-    assert!(msg.contains("structures") && msg.contains("--max-memory"), "{msg}");
+    assert!(
+        msg.contains("structures") && msg.contains("--max-memory"),
+        "{msg}"
+    );
 }

@@ -17,6 +17,7 @@ mod output;
 mod profiles;
 mod reference;
 mod scenes;
+mod trees;
 
 pub use scenes::default_mesh_dirs;
 
@@ -60,6 +61,8 @@ pub struct Config {
     pub mesh_dirs: Vec<PathBuf>,
     /// The fast variant (smaller images, shorter sweeps).
     pub quick: bool,
+    /// Run only the paper-scale tree experiments ([`trees`]).
+    pub trees: bool,
 }
 
 /// A failure, with a message for a person.
@@ -102,7 +105,10 @@ pub trait Experiment {
 }
 
 /// Every experiment, in report order.
-fn experiments() -> Vec<Box<dyn Experiment>> {
+fn experiments(config: &Config) -> Vec<Box<dyn Experiment>> {
+    if config.trees {
+        return vec![Box::new(trees::TreeExperiment)];
+    }
     vec![
         Box::new(profiles::ProfileComparison),
         Box::new(scenes::SceneComparison),
@@ -154,15 +160,22 @@ pub fn run(config: &Config) -> Result<(), Error> {
             bar.println(msg);
         }
     };
-    log(&format!(
-        "compare: {} preset(s), {} photons per channel, seed {}, {} bins -> {}",
-        presets.len(),
-        config.photons,
-        config.seed,
-        config.bins,
-        config.out.display()
-    ));
-    let references = reference::load_or_compute(config, &presets, &log, &bar)?;
+    if !config.trees {
+        log(&format!(
+            "compare: {} preset(s), {} photons per channel, seed {}, {} bins -> {}",
+            presets.len(),
+            config.photons,
+            config.seed,
+            config.bins,
+            config.out.display()
+        ));
+    }
+    // The tree experiments use no Monte Carlo reference.
+    let references = if config.trees {
+        Vec::new()
+    } else {
+        reference::load_or_compute(config, &presets, &log, &bar)?
+    };
     bar.finish_and_clear();
     let ctx = Context {
         config,
@@ -170,7 +183,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
         log: &|msg| eprintln!("{msg}"),
     };
     let mut sections = Vec::new();
-    for exp in experiments() {
+    for exp in experiments(config) {
         eprintln!("experiment {}", exp.name());
         sections.push(exp.run(&ctx)?);
     }

@@ -349,6 +349,46 @@ impl Dual<'_> {
     }
 }
 
+/// The names of the extra layers: s_p per pixel (the largest over its samples, grey) and the
+/// pixel clusters (Milaenen et al. Fig. 5: the cut of the pixel tree where LENGTH < ρ / max
+/// s_p, one random colour per cluster; a leaf above the cut shows each point alone).
+pub const LAYERS: [&str; 2] = ["sampling_rate", "pixel_clusters"];
+
+/// Per point in tree order, a label of the cluster SHADE shades it with (the pixel tree's cut
+/// at Eq. 6, independent of the illumination node).
+fn cluster_labels(px: &PixelTree, rho: f64) -> Vec<u64> {
+    let mut labels = vec![0u64; px.tree.order.len()];
+    if px.tree.nodes.is_empty() {
+        return labels;
+    }
+    let mut stack = vec![0u32];
+    while let Some(s) = stack.pop() {
+        let n = &px.tree.nodes[s as usize];
+        let range = n.start as usize..n.end as usize;
+        if px.length_px(n) * px.clusters[s as usize].max_rate < rho {
+            labels[range].fill(u64::from(s) + 1);
+        } else if n.is_leaf() {
+            for k in range {
+                labels[k] = (1 << 40) + k as u64;
+            }
+        } else {
+            stack.push(n.right);
+            stack.push(n.left);
+        }
+    }
+    labels
+}
+
+/// A colour in [0.2, 1]³ for a cluster label (0: black).
+fn label_colour(label: u64) -> Rgb {
+    if label == 0 {
+        return [0.0; 3];
+    }
+    let h = sss_util::splitmix64(label);
+    let c = |shift: u32| 0.2 + 0.8 * ((h >> shift) & 0xff) as f64 / 255.0;
+    [c(0), c(8), c(16)]
+}
+
 /// The task roots: pixel-tree nodes with at most [`TASK_ITEMS`] points whose parent has more
 /// (or the root), in tree order.
 fn tasks(px: &PixelTree) -> Vec<u32> {
@@ -381,6 +421,10 @@ impl Integrator for DualTree {
         )
     }
 
+    fn layer_names(&self) -> &'static [&'static str] {
+        &LAYERS
+    }
+
     fn irradiance_settings(&self) -> Option<IrradianceSettings> {
         Some(self.irradiance)
     }
@@ -411,6 +455,9 @@ impl Integrator for DualTree {
                 .collect()
         });
         let counts = Counts::default();
+        let pixels = frame.gbuffer.pixels();
+        let mut rate_layer = vec![[0.0; 3]; pixels];
+        let mut cluster_layer = vec![[0.0; 3]; pixels];
         let mut values = vec![[0.0; 3]; frame.gbuffer.samples.len()];
         let mut shaded_points = 0u64;
         frame.timed("shading", || {
@@ -454,12 +501,21 @@ impl Integrator for DualTree {
                 } else {
                     progress.advance(ordered.len() as u64);
                 }
+                let labels = cluster_labels(px, self.rho);
                 for (k, &item) in px.tree.order.iter().enumerate() {
                     let gi = index[item as usize] as usize;
                     let g = &frame.gbuffer.samples[gi];
                     let mut v = [0.0; 3];
                     add_scaled(&mut v, acc[k], sh.exit_weight(g.n, g.wo));
                     values[gi] = v;
+                    let p = g.pixel as usize;
+                    let r = ordered[k].rate;
+                    if r > rate_layer[p][0] {
+                        rate_layer[p] = [r; 3];
+                    }
+                    if g.index == 0 || cluster_layer[p] == [0.0; 3] {
+                        cluster_layer[p] = label_colour(labels[k]);
+                    }
                 }
             }
         });
@@ -481,6 +537,16 @@ impl Integrator for DualTree {
         Ok(Shaded {
             values,
             stats,
+            layers: vec![
+                super::Layer {
+                    name: LAYERS[0],
+                    pixels: rate_layer,
+                },
+                super::Layer {
+                    name: LAYERS[1],
+                    pixels: cluster_layer,
+                },
+            ],
             ..Shaded::default()
         })
     }

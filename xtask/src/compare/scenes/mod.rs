@@ -95,14 +95,19 @@ impl Experiment for SceneComparison {
                         ));
                         let method = (m.build)(&MethodOptions::new().with(m.sweep.option, v))
                             .map_err(|e| Error(format!("{label}: {e}")))?;
-                        let out = match run_timed(method.as_ref(), scene, &settings, threads, &label)? {
-                            Outcome::Done(out) => out,
-                            Outcome::Unsupported(why) => {
-                                (ctx.log)(&format!("scene {}: {} skipped: {why}", scene.name, m.name));
-                                unsupported.push(format!("`{}` on `{}`: {why}", m.name, scene.name));
-                                continue 'methods;
-                            }
-                        };
+                        let out =
+                            match run_timed(method.as_ref(), scene, &settings, threads, &label)? {
+                                Outcome::Done(out) => out,
+                                Outcome::Unsupported(why) => {
+                                    (ctx.log)(&format!(
+                                        "scene {}: {} skipped: {why}",
+                                        scene.name, m.name
+                                    ));
+                                    unsupported
+                                        .push(format!("`{}` on `{}`: {why}", m.name, scene.name));
+                                    continue 'methods;
+                                }
+                            };
                         for w in &out.warnings {
                             (ctx.log)(&format!("scene {}: {label}: warning: {w}", scene.name));
                         }
@@ -251,7 +256,10 @@ impl Experiment for SceneComparison {
             let _ = writeln!(summary, "\nSkipped {s}");
         }
         if !unsupported.is_empty() {
-            let _ = writeln!(summary, "\nMethods that cannot render a scene (not run there):\n");
+            let _ = writeln!(
+                summary,
+                "\nMethods that cannot render a scene (not run there):\n"
+            );
             for u in &unsupported {
                 let _ = writeln!(summary, "- {u}");
             }
