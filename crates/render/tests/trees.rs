@@ -213,3 +213,38 @@ fn tree_structures_count_against_the_memory_budget() {
         "{msg}"
     );
 }
+
+#[test]
+fn curvature_at_the_hits_matches_the_analytic_sphere() {
+    use sss_render::integrators::dual_tree::curvature_at_hits;
+    // The built-in sphere has radius 1: k = 1 everywhere (the procedural shape's analytic
+    // curvature), estimated per vertex and interpolated at each hit.
+    let s = scene("sphere", 80, 60);
+    let frame = Frame::prepare(&s, 1);
+    let o = frame.visible[0];
+    let (index, k) = curvature_at_hits(&frame, o).unwrap();
+    assert_eq!(index.len(), k.len());
+    assert!(index.len() > 1000);
+    let worst = k.iter().fold(0.0f64, |m, &x| m.max((x - 1.0).abs()));
+    assert!(worst < 0.02, "sphere: |k − 1/R| up to {worst}");
+    // The slab's top face: flat, k = 0 away from its edges (the box's edge vertices see the
+    // 90° turn, so only hits well inside a face are checked).
+    let s = scene("slab", 80, 60);
+    let frame = Frame::prepare(&s, 1);
+    for &o in &frame.visible {
+        let (index, k) = curvature_at_hits(&frame, o).unwrap();
+        let mut interior = 0;
+        for (&i, &kk) in index.iter().zip(&k) {
+            let g = &frame.gbuffer.samples[i as usize];
+            assert!(kk.is_finite() && kk >= 0.0);
+            // The slab is 4 × 0.4 × 3 centred at (0, 0.2, 0): its top face is y = 0.4.
+            if (g.p.y - 0.4).abs() < 1e-9 && g.p.x.abs() < 1.5 && g.p.z.abs() < 1.0 {
+                interior += 1;
+                assert!(kk < 1e-9, "flat face curvature {kk} at {:?}", g.p);
+            }
+        }
+        if o == frame.visible[0] {
+            assert!(interior > 50, "{interior} interior hits");
+        }
+    }
+}

@@ -176,6 +176,33 @@ fn rate_at(
         .map_err(|e| Error::Input(format!("material `{}`: s_p: {e}", sh.name)))
 }
 
+/// The G-buffer samples on object `o` (indices, ascending) and the curvature k = max(|κ₁|,
+/// |κ₂|) at each (1/scene unit): per mesh vertex by Rusinkiewicz 2004
+/// ([`vertex_max_abs_curvature`]), interpolated with the hit's barycentric coordinates.
+pub fn curvature_at_hits(frame: &Frame<'_>, o: u32) -> Result<(Vec<u32>, Vec<f64>), Error> {
+    let object = &frame.scene.objects[o as usize];
+    let mesh = &object.mesh;
+    let coords: Vec<[f64; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
+    let k = vertex_max_abs_curvature(&coords, &mesh.triangles)
+        .map_err(|e| Error::Input(format!("object `{}`: curvature: {e}", object.name)))?;
+    let index: Vec<u32> = (0..frame.gbuffer.samples.len() as u32)
+        .filter(|&i| frame.gbuffer.samples[i as usize].object == o)
+        .collect();
+    let curvature = index
+        .par_iter()
+        .map(|&i| {
+            let g = &frame.gbuffer.samples[i as usize];
+            interpolate(
+                &mesh.positions,
+                mesh.triangles[g.triangle as usize],
+                &k,
+                g.p,
+            )
+        })
+        .collect();
+    Ok((index, curvature))
+}
+
 /// The shading points of every visible translucent object with their s_p, and the G-buffer
 /// index of each, per object.
 type ObjectPoints = Vec<Option<(Vec<PixelPoint>, Vec<u32>)>>;
@@ -208,23 +235,12 @@ fn shading_points(frame: &Frame<'_>) -> Result<ObjectPoints, Error> {
         ) else {
             continue;
         };
-        let mesh = &scene.objects[o as usize].mesh;
-        let coords: Vec<[f64; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
-        let k = vertex_max_abs_curvature(&coords, &mesh.triangles).map_err(|e| {
-            Error::Input(format!(
-                "object `{}`: curvature: {e}",
-                scene.objects[o as usize].name
-            ))
-        })?;
-        let index: Vec<u32> = (0..frame.gbuffer.samples.len() as u32)
-            .filter(|&i| frame.gbuffer.samples[i as usize].object == o)
-            .collect();
+        let (index, curvature) = curvature_at_hits(frame, o)?;
         let points: Vec<PixelPoint> = index
             .par_iter()
-            .map(|&i| {
+            .zip(&curvature)
+            .map(|(&i, &k_scene)| {
                 let g = &frame.gbuffer.samples[i as usize];
-                let tri = mesh.triangles[g.triangle as usize];
-                let k_scene = interpolate(&mesh.positions, tri, &k, g.p);
                 let rate = rate_at(g, k_scene, sh, bw, &footprint)?;
                 Ok(PixelPoint {
                     screen: [
