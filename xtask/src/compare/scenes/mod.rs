@@ -24,6 +24,7 @@ use images::write_images;
 use runs::{Outcome, Run, csv_rows, run_timed};
 use sss_plot::{PALETTE, Series, SeriesStyle, line_plot};
 use sss_render::image::{auto_exposure, write_png};
+use sss_render::integrators::exact::reference_spacing;
 use sss_render::integrators::{METHODS, MethodOptions};
 use sss_render::metrics::{error_figures, frac_within_se, mean_ratio};
 use sss_render::render::RenderSettings;
@@ -93,8 +94,17 @@ impl Experiment for SceneComparison {
                             "scene {}: {label} ({threads} thread(s))",
                             scene.name
                         ));
-                        let method = (m.build)(&MethodOptions::new().with(m.sweep.option, v))
-                            .map_err(|e| Error(format!("{label}: {e}")))?;
+                        // Point-based methods sweeping another option sum over the
+                        // reference's own irradiance samples, so their error is their
+                        // approximation's alone.
+                        let mut options = MethodOptions::new().with(m.sweep.option, v);
+                        if m.sweep.option != "spacing"
+                            && m.options.iter().any(|o| o.name == "spacing")
+                        {
+                            options = options.with("spacing", reference_spacing(cfg.quick));
+                        }
+                        let method =
+                            (m.build)(&options).map_err(|e| Error(format!("{label}: {e}")))?;
                         let out =
                             match run_timed(method.as_ref(), scene, &settings, threads, &label)? {
                                 Outcome::Done(out) => out,
