@@ -11,6 +11,10 @@
 //! Σ_i A_i Σ_k S(x_i, ω_k; x_o, ω_o) E_k for the directional dipole,
 //!
 //! or the integral these sums approximate, with E_i = Σ_k F_t(η, cos θ_k) E_k · texture(x_i).
+//! In the radial sum, R_d(‖x_i − x_o‖) stands for
+//! [`rd_sample_scene`](TranslucentShading::rd_sample_scene): R_d averaged over sample i's own
+//! disk of area A_i near x_o, the point value with its second-order correction farther away,
+//! so that the sum estimates the integral pixel by pixel even for peaked profiles.
 
 use crate::lights::Incident;
 use glam::DVec3;
@@ -136,13 +140,14 @@ impl TranslucentShading {
     ///   exceed [`DISK_FAR_MAX_CORRECTION`]): the disk average by a fixed quadrature of at most
     ///   [`DISK_EVALUATIONS_MAX`] evaluations of R_d, written in polar coordinates around x_o
     ///   so that peaked profiles (R_d → ∞ as r → 0) are integrated exactly where they peak;
-    ///   see [`DiskRule`]. Within 0.3 % of a fine brute-force quadrature for every model and
+    ///   see [`disk_average`](Self::disk_average). Within 0.3 % of a fine brute-force quadrature for every model and
     ///   r/a for disks of radius up to one reduced mean free path, 2 % up to four
     ///   (`disk_average_matches_brute_force`).
     /// - **Far**: the mean-value expansion of a smooth function over a disk,
     ///   R_d(r) (1 + (a²/8) ∇²R_d(r)/R_d(r)) + O(a⁴ ∇⁴R_d) (Pólya & Szegő; the Laplacian of a
     ///   radial profile is R_d'' + R_d'/r), with ∇²R_d/R_d from a per-material table
-    ///   ([`DiskRule`]): one R_d evaluation and a table look-up. The correction matters even far
+    ///   (built with the model: ∇²R_d/R_d by central differences on a geometric grid of 32
+    ///   radii per decade, interpolated in log r): one R_d evaluation and a table look-up. The correction matters even far
     ///   away: for an exponential tail e^{−σr} it tends to (σa)²/8, not to 0, so the bare point
     ///   value would be off by a constant factor (up to 13 % for ketchup at a = ℓ/2). Taken
     ///   only where the correction is at most [`DISK_FAR_MAX_CORRECTION`], which bounds the
@@ -173,8 +178,17 @@ impl TranslucentShading {
     }
 
     /// R_d averaged over a disk of radius `a` centred at distance `r` from the shading point
-    /// (scene units, r ≥ 0, a > 0), always by the quadrature of [`DiskRule`] (the near branch
-    /// of [`rd_sample_scene`](Self::rd_sample_scene)).
+    /// (scene units, r ≥ 0, a > 0), always by quadrature (the near branch of
+    /// [`rd_sample_scene`](Self::rd_sample_scene)).
+    ///
+    /// The mean is written in polar coordinates around the shading point x_o (not around the
+    /// disk's centre, where a peaked profile would sit off-centre): (1/πa²) ∫ 2π s φ(s) R_d(s)
+    /// ds, with φ(s) the fraction of the circle of radius s around x_o inside the disk (1 for
+    /// s ≤ a − r; arccos((s² + r² − a²)/(2sr))/π on |a − r| < s < a + r, the circle–circle
+    /// intersection angle). The inner part ∫₀^{a−r} is Gauss–Legendre on panels shrinking by 4
+    /// towards s = 0; the ring part Gauss–Legendre in τ after s = m − h cos τ
+    /// (m = max(a, r), h = min(a, r)), which removes φ's square-root ends. At most
+    /// [`DISK_EVALUATIONS_MAX`] evaluations of R_d.
     pub fn disk_average(&self, r: f64, a: f64) -> Rgb {
         let rule = &self.disk;
         let mut acc = [0.0; 3];
