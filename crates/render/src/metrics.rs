@@ -2,6 +2,11 @@
 //! relative RMSE, the fraction of pixels within a relative error, the mean ratio against a
 //! reference, and the fraction within k standard errors. All are taken over a list of pixel
 //! indices (the pixels with translucent coverage, by convention) and never return NaN.
+//!
+//! At resolutions where a reference of every pixel is too slow, [`subset_pixels`] draws a
+//! seeded uniform random subset of those pixels, the reference is computed there only
+//! ([`crate::integrators::exact::shade_subset`]), and [`subset_error`] estimates the full
+//! image's mean squared error from the subset, with its standard error.
 
 use sss_bssrdf::Rgb;
 
@@ -120,6 +125,124 @@ pub fn frac_within_se(
     Some(ok as f64 / pixels.len() as f64)
 }
 
+/// A seeded uniform random subset of `n` distinct entries of `pixels` (all of them when
+/// `n ≥ pixels.len()`), in increasing order: a partial Fisher–Yates shuffle driven by
+/// SplitMix64 (`sss_util::splitmix64`) from `seed`, each index drawn as ⌊x·m/2⁶⁴⌋ from a 64-bit
+/// x (bias below m/2⁶⁴). The same seed gives the same subset on every machine.
+pub fn subset_pixels(pixels: &[usize], n: usize, seed: u64) -> Vec<usize> {
+    let mut v = pixels.to_vec();
+    let n = n.min(v.len());
+    let base = sss_util::splitmix64(seed ^ 0x5375_6273_6574_0000); // "Subset"
+    for i in 0..n {
+        let m = (v.len() - i) as u128;
+        let x = sss_util::splitmix64(base.wrapping_add(i as u64)) as u128;
+        let j = i + ((x * m) >> 64) as usize;
+        v.swap(i, j);
+    }
+    v.truncate(n);
+    v.sort_unstable();
+    v
+}
+
+/// The error of an image estimated over a uniform random subset of the pixels it is scored on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubsetError {
+    /// Pixels in the subset (n).
+    pub pixels: usize,
+    /// Pixels the subset was drawn from (N): the pixels with translucent coverage.
+    pub population: usize,
+    /// The mean over the subset of each pixel's squared error averaged over channels: an
+    /// unbiased estimate of the full image's MSE over the N pixels (the square of
+    /// [`ErrorFigures::rmse`]).
+    pub mse: f64,
+    /// Its standard error, √((1 − n/N) s²/n) with s² the subset's sample variance of the
+    /// per-pixel squared errors (sampling without replacement, with the finite-population
+    /// correction: 0 when the subset is every pixel; Cochran, *Sampling Techniques*, 3rd ed.,
+    /// Thm. 2.2 and Eq. 2.9).
+    pub mse_se: f64,
+    /// √mse: the RMSE estimate (biased low by O(mse_se²/mse^{3/2}), as any square root of an
+    /// unbiased estimate).
+    pub rmse: f64,
+    /// The RMSE's standard error by the delta method, mse_se/(2 √mse) (0 when mse is 0).
+    pub rmse_se: f64,
+}
+
+/// Estimates the MSE of `image` (every pixel) over the `population` pixels with translucent
+/// coverage from the uniform random `subset` of them ([`subset_pixels`]) and the reference's
+/// values there, `reference[k]` for pixel `subset[k]`. Errors on mismatched lengths, a subset
+/// larger than the population, a repeated pixel or an index past the image; an empty subset
+/// gives 0 with a 0 standard error (as [`error_figures`] does for no pixels).
+pub fn subset_error(
+    image: &[Rgb],
+    subset: &[usize],
+    reference: &[Rgb],
+    population: usize,
+) -> Result<SubsetError, crate::Error> {
+    let fail = |m: String| Err(crate::Error::Input(format!("subset error: {m}")));
+    if subset.len() != reference.len() {
+        return fail(format!(
+            "{} pixels but {} reference values",
+            subset.len(),
+            reference.len()
+        ));
+    }
+    if subset.len() > population {
+        return fail(format!(
+            "a subset of {} pixels from a population of {population}",
+            subset.len()
+        ));
+    }
+    if let Some(&i) = subset.iter().find(|&&i| i >= image.len()) {
+        return fail(format!(
+            "pixel {i} is past the image's {} pixels",
+            image.len()
+        ));
+    }
+    let mut sorted = subset.to_vec();
+    sorted.sort_unstable();
+    if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+        return fail(format!("pixel {} appears twice", w[0]));
+    }
+    let n = subset.len();
+    let e: Vec<f64> = subset
+        .iter()
+        .zip(reference)
+        .map(|(&i, r)| (0..3).map(|c| (image[i][c] - r[c]).powi(2)).sum::<f64>() / 3.0)
+        .collect();
+    let mse = if n > 0 {
+        e.iter().sum::<f64>() / n as f64
+    } else {
+        0.0
+    };
+    let mse_se = if n > 1 {
+        let s2 = e.iter().map(|x| (x - mse).powi(2)).sum::<f64>() / (n - 1) as f64;
+        let fpc = (1.0 - n as f64 / population as f64).max(0.0);
+        (fpc * s2 / n as f64).sqrt()
+    } else {
+        0.0
+    };
+    let rmse = mse.sqrt();
+    let figures = SubsetError {
+        pixels: n,
+        population,
+        mse,
+        mse_se,
+        rmse,
+        rmse_se: if rmse > 0.0 {
+            mse_se / (2.0 * rmse)
+        } else {
+            0.0
+        },
+    };
+    if [mse, mse_se, rmse].iter().all(|v| v.is_finite()) {
+        Ok(figures)
+    } else {
+        Err(crate::Error::NonFinite(format!(
+            "subset error: non-finite figures {figures:?} (a pixel value is not finite)"
+        )))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -208,5 +331,57 @@ mod tests {
             frac_within_se(&off, &[[0.0; 3]], &big, &[0], 3.0),
             Some(0.0)
         );
+    }
+
+    /// The subset is uniform and seeded: distinct, sorted, drawn from the list, the same for the
+    /// same seed; over many seeds every pixel is drawn about n/N of the time (binomial, 4.5 σ).
+    #[test]
+    fn subset_pixels_are_uniform_and_seeded() {
+        let pool: Vec<usize> = (0..50).map(|k| 3 * k + 1).collect();
+        let s = subset_pixels(&pool, 10, 7);
+        assert_eq!(s.len(), 10);
+        assert!(s.windows(2).all(|w| w[0] < w[1]));
+        assert!(s.iter().all(|p| pool.contains(p)));
+        assert_eq!(s, subset_pixels(&pool, 10, 7));
+        assert_ne!(s, subset_pixels(&pool, 10, 8));
+        assert_eq!(subset_pixels(&pool, 80, 1), pool);
+        let trials = 4000;
+        let mut count = [0usize; 50];
+        for seed in 0..trials {
+            for p in subset_pixels(&pool, 10, seed) {
+                count[(p - 1) / 3] += 1;
+            }
+        }
+        // Each pixel: Binomial(4000, 1/5), mean 800, σ = √(4000·0.2·0.8) ≈ 25.3.
+        for (k, &c) in count.iter().enumerate() {
+            assert!((c as f64 - 800.0).abs() < 4.5 * 25.3, "pixel {k}: {c}");
+        }
+    }
+
+    /// Closed forms: per-pixel squared errors 1, 4, 9, 16 over a population of 8.
+    #[test]
+    fn subset_error_closed_form() {
+        let image = vec![[0.0; 3]; 10];
+        let reference = vec![[1.0; 3], [2.0; 3], [3.0; 3], [4.0; 3]];
+        let e = subset_error(&image, &[0, 2, 4, 6], &reference, 8).unwrap();
+        // Mean 7.5; s² = (6.5² + 3.5² + 1.5² + 8.5²)/3 = 129/3 = 43; SE = √((1 − 4/8)·43/4).
+        assert!((e.mse - 7.5).abs() < 1e-14);
+        assert!((e.mse_se - (0.5f64 * 43.0 / 4.0).sqrt()).abs() < 1e-14);
+        assert!((e.rmse - 7.5f64.sqrt()).abs() < 1e-14);
+        assert!((e.rmse_se - e.mse_se / (2.0 * 7.5f64.sqrt())).abs() < 1e-14);
+        // The whole population: no sampling error.
+        assert_eq!(
+            subset_error(&image, &[0, 2, 4, 6], &reference, 4)
+                .unwrap()
+                .mse_se,
+            0.0
+        );
+        // Bad input is an error, not a panic.
+        assert!(subset_error(&image, &[0, 2], &reference, 8).is_err());
+        assert!(subset_error(&image, &[0, 2, 4, 6], &reference, 3).is_err());
+        assert!(subset_error(&image, &[0, 2, 4, 60], &reference, 8).is_err());
+        assert!(subset_error(&image, &[0, 2, 2, 6], &reference, 8).is_err());
+        let none = subset_error(&image, &[], &[], 8).unwrap();
+        assert_eq!((none.mse, none.mse_se, none.rmse_se), (0.0, 0.0, 0.0));
     }
 }

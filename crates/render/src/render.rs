@@ -298,11 +298,7 @@ fn assemble(
                     frame.shade_opaque_with(g, settings.opaque_light_samples, packets)
                 };
                 for c in 0..3 {
-                    let v = if v[c].is_finite() && v[c] > 0.0 {
-                        v[c]
-                    } else {
-                        0.0
-                    };
+                    let v = pixel_value(v[c]);
                     total[c] += v / spp;
                     if translucent {
                         sss[c] += v / spp;
@@ -317,4 +313,25 @@ fn assemble(
         });
     frame.record("opaque", t.elapsed().as_secs_f64());
     (subsurface_px, total_px, coverage)
+}
+
+/// A sample's value as a pixel counts it: non-finite or negative values count as 0.
+#[inline]
+fn pixel_value(v: f64) -> f64 {
+    if v.is_finite() && v > 0.0 { v } else { 0.0 }
+}
+
+/// A pixel's subsurface value from its camera samples' values (`None` for samples off
+/// translucent objects, which count 0), exactly as [`render`] assembles it: the sum of each
+/// sample's value over `samples_per_pixel` (misses count 0 too), non-finite or negative
+/// values counting 0. Shared with [`crate::integrators::exact::shade_subset`].
+pub fn assembled_subsurface(values: &[Option<Rgb>], samples_per_pixel: u32) -> Rgb {
+    let spp = samples_per_pixel as f64;
+    let mut sss = [0.0; 3];
+    for v in values.iter().flatten() {
+        for c in 0..3 {
+            sss[c] += pixel_value(v[c]) / spp;
+        }
+    }
+    sss
 }

@@ -11,6 +11,10 @@
 //! Σ_i A_i Σ_k S(x_i, ω_k; x_o, ω_o) E_k for the directional dipole,
 //!
 //! or the integral these sums approximate, with E_i = Σ_k F_t(η, cos θ_k) E_k · texture(x_i).
+//! In the radial sum, R_d(‖x_i − x_o‖) stands for
+//! [`rd_sample_scene`](TranslucentShading::rd_sample_scene): R_d averaged over sample i's own
+//! disk of area A_i near x_o, the point value with its second-order correction farther away,
+//! so that the sum estimates the integral pixel by pixel even for peaked profiles.
 
 use crate::lights::Incident;
 use glam::DVec3;
@@ -62,6 +66,8 @@ pub struct TranslucentShading {
     pub norm: f64,
     /// The pre-scatter texture.
     pub texture: Option<Texture>,
+    /// The disk-average quadrature of [`rd_sample_scene`](Self::rd_sample_scene).
+    disk: DiskRule,
 }
 
 impl TranslucentShading {
@@ -74,6 +80,7 @@ impl TranslucentShading {
         } else {
             ShadingModel::Radial(bssrdf)
         };
+        let disk = DiskRule::new(model.bssrdf(), &t.medium, t.units_per_mm);
         TranslucentShading {
             name: name.to_string(),
             kind: t.model,
@@ -82,6 +89,7 @@ impl TranslucentShading {
             eta,
             norm: 1.0 / (fresnel_normalization(eta) * PI),
             texture: t.texture.clone(),
+            disk,
         }
     }
 
@@ -121,16 +129,122 @@ impl TranslucentShading {
     }
 
     /// The R_d an irradiance sample of area `area` (scene units²) contributes per unit area at
-    /// scene-unit distance `r` from the shading point: the sample stands for a patch of the
-    /// surface, so near the shading point (where R_d is peaked) this is meant to be R_d
-    /// averaged over the sample's disk rather than the point value. Every point-sum method
-    /// (`exact`, the tree leaves) calls this, so they approximate the same sum.
+    /// scene-unit distance `r` from the shading point x_o. The sample stands for a patch of the
+    /// surface, so this is R_d averaged over a disk of that area (radius a = √(A/π)) centred
+    /// at distance r from x_o, in the tangent plane (the planar approximation: the curvature of
+    /// the surface over one sample's disk is neglected, as the models neglect it everywhere);
+    /// far from x_o, the point value R_d(r). Every point-sum method (`exact`, the tree leaves)
+    /// calls this, so they approximate the same sum.
     ///
-    /// Today: the point value [`rd_scene`](Self::rd_scene) (`area` unused).
+    /// - **Near** (r < [`DISK_FAR_RATIO`]·a, or wherever the far branch's correction would
+    ///   exceed [`DISK_FAR_MAX_CORRECTION`]): the disk average by a fixed quadrature of at most
+    ///   [`DISK_EVALUATIONS_MAX`] evaluations of R_d, written in polar coordinates around x_o
+    ///   so that peaked profiles (R_d → ∞ as r → 0) are integrated exactly where they peak;
+    ///   see [`disk_average`](Self::disk_average). Within 0.3 % of a fine brute-force quadrature for every model and
+    ///   r/a for disks of radius up to one reduced mean free path, 2 % up to four
+    ///   (`disk_average_matches_brute_force`).
+    /// - **Far**: the mean-value expansion of a smooth function over a disk,
+    ///   R_d(r) (1 + (a²/8) ∇²R_d(r)/R_d(r)) + O(a⁴ ∇⁴R_d) (Pólya & Szegő; the Laplacian of a
+    ///   radial profile is R_d'' + R_d'/r), with ∇²R_d/R_d from a per-material table
+    ///   (built with the model: ∇²R_d/R_d by central differences on a geometric grid of 32
+    ///   radii per decade, interpolated in log r): one R_d evaluation and a table look-up. The correction matters even far
+    ///   away: for an exponential tail e^{−σr} it tends to (σa)²/8, not to 0, so the bare point
+    ///   value would be off by a constant factor (up to 13 % for ketchup at a = ℓ/2). Taken
+    ///   only where the correction is at most [`DISK_FAR_MAX_CORRECTION`], which bounds the
+    ///   neglected fourth-order term; within 1.5 % of the brute force for every model and medium
+    ///   tested (`far_branch_is_within_its_tolerance`).
+    ///
+    /// `area` ≤ 0 or not finite gives the point value; the result is finite and non-negative
+    /// for every r ≥ 0 (including r = 0) and every area.
     #[inline]
     pub fn rd_sample_scene(&self, r: f64, area: f64) -> Rgb {
-        let _ = area;
-        self.rd_scene(r)
+        let r = if r.is_finite() { r.abs() } else { r };
+        if !(area > 0.0 && area.is_finite() && r.is_finite()) {
+            return self.rd_scene(r);
+        }
+        let a2 = area / PI;
+        let a = a2.sqrt();
+        if r >= DISK_FAR_RATIO * a {
+            let lap = self.disk.laplacian(r / self.units_per_mm);
+            let u2 = self.units_per_mm * self.units_per_mm;
+            // a²/8 · ∇²R_d / R_d, with ∇² per mm² converted to per scene unit².
+            let t = lap.map(|l| a2 / u2 * l * 0.125);
+            if t.iter().all(|t| t.abs() <= DISK_FAR_MAX_CORRECTION) {
+                let rd = self.rd_scene(r);
+                return [0, 1, 2].map(|c| rd[c] * (1.0 + t[c]));
+            }
+        }
+        self.disk_average(r, a)
+    }
+
+    /// R_d averaged over a disk of radius `a` centred at distance `r` from the shading point
+    /// (scene units, r ≥ 0, a > 0), always by quadrature (the near branch of
+    /// [`rd_sample_scene`](Self::rd_sample_scene)).
+    ///
+    /// The mean is written in polar coordinates around the shading point x_o (not around the
+    /// disk's centre, where a peaked profile would sit off-centre): (1/πa²) ∫ 2π s φ(s) R_d(s)
+    /// ds, with φ(s) the fraction of the circle of radius s around x_o inside the disk (1 for
+    /// s ≤ a − r; arccos((s² + r² − a²)/(2sr))/π on |a − r| < s < a + r, the circle–circle
+    /// intersection angle). The inner part ∫₀^{a−r} is Gauss–Legendre on panels shrinking by 4
+    /// towards s = 0; the ring part Gauss–Legendre in τ after s = m − h cos τ
+    /// (m = max(a, r), h = min(a, r)), which removes φ's square-root ends. At most
+    /// [`DISK_EVALUATIONS_MAX`] evaluations of R_d.
+    pub fn disk_average(&self, r: f64, a: f64) -> Rgb {
+        let rule = &self.disk;
+        let mut acc = [0.0; 3];
+        let mut add = |s: f64, w: f64| {
+            let rd = self.rd_scene(s);
+            for c in 0..3 {
+                acc[c] += w * s * rd[c];
+            }
+        };
+        // Inside: circles of radius s ≤ a − r around x_o lie wholly in the disk, so this part
+        // is ∫₀^{a−r} s R_d(s) ds, on panels shrinking by 4 towards s = 0 (down to a quarter of
+        // the smallest mean free path, at most DISK_PANELS_MAX of them) where peaked profiles
+        // vary fastest.
+        if r < a {
+            let b = a - r;
+            let mut hi = b;
+            let panels = disk_panels(b, rule.panel_floor);
+            for k in 0..panels {
+                let lo = if k + 1 == panels { 0.0 } else { 0.25 * hi };
+                let (half, mid) = (0.5 * (hi - lo), 0.5 * (hi + lo));
+                for &(x, w) in &rule.inner {
+                    add(mid + half * x, w * half);
+                }
+                hi = lo;
+            }
+        }
+        // The ring |a − r| < s < a + r, where a fraction φ(s) of the circle of radius s lies
+        // in the disk: φ = arccos((s² + r² − a²)/(2sr))/π. With s = m − h cos τ, τ ∈ [0, π]
+        // (m = max(a, r), h = min(a, r)), ds = h sin τ dτ removes the square-root behaviour of
+        // φ at both ends, so Gauss–Legendre in τ converges fast.
+        let (m, h) = if r < a { (a, r) } else { (r, a) };
+        if h > 0.0 {
+            for &(cos_t, w) in &rule.ring {
+                let sin2 = (1.0 - cos_t * cos_t).max(0.0);
+                let s = m - h * cos_t;
+                if !(s > 0.0) {
+                    continue;
+                }
+                // (s² + r² − a²)/(2sr), expanded so that it stays accurate as r or a → 0.
+                let x = if r < a {
+                    (r * (1.0 + cos_t * cos_t) - 2.0 * a * cos_t) / (2.0 * s)
+                } else {
+                    1.0 - a * a * sin2 / (2.0 * s * r)
+                };
+                let phi = x.clamp(-1.0, 1.0).acos() / PI;
+                add(s, w * h * sin2.sqrt() * phi);
+            }
+        }
+        // Mean = (2π/(πa²)) · (the two parts).
+        let scale = 2.0 / (a * a);
+        let out = acc.map(|v| v * scale);
+        if out.iter().all(|v| v.is_finite()) {
+            out.map(|v| v.max(0.0))
+        } else {
+            self.rd_scene(r)
+        }
     }
 
     /// The exit weight F_t(η, n·ω_o)/(cπ) of a radial model at a point with shading normal `n`
@@ -176,4 +290,386 @@ pub fn shading_for(scene: &Scene, objects: &[u32]) -> Vec<Option<TranslucentShad
         }
     }
     out
+}
+
+/// At and beyond this many disk radii from the shading point,
+/// [`TranslucentShading::rd_sample_scene`] may use the far branch (point value with the
+/// second-order correction), when that correction is small ([`DISK_FAR_MAX_CORRECTION`]).
+pub const DISK_FAR_RATIO: f64 = 3.0;
+
+/// The far branch of [`TranslucentShading::rd_sample_scene`] is taken only where the relative
+/// second-order correction (a²/8)|∇²R_d/R_d| is at most this in every channel; larger
+/// corrections (coarse irradiance samples on steep profiles) mean that the neglected
+/// fourth-order term may not be small, and the disk is integrated instead.
+pub const DISK_FAR_MAX_CORRECTION: f64 = 0.125;
+
+/// Gauss–Legendre points per panel of the inner part of the disk average.
+const DISK_INNER_POINTS: usize = 6;
+/// Gauss–Legendre points in τ for the ring part of the disk average.
+const DISK_RING_POINTS: usize = 16;
+/// At most this many panels for the inner part.
+const DISK_PANELS_MAX: usize = 8;
+
+/// The most R_d evaluations one disk average makes.
+pub const DISK_EVALUATIONS_MAX: usize = DISK_PANELS_MAX * DISK_INNER_POINTS + DISK_RING_POINTS;
+
+/// Panels for ∫₀^b: from b down by factors of 4 until the innermost edge is at most
+/// `floor` (at least 3 panels, at most [`DISK_PANELS_MAX`]).
+fn disk_panels(b: f64, floor: f64) -> usize {
+    let mut panels = 3;
+    let mut edge = b / 16.0;
+    while edge > floor && panels < DISK_PANELS_MAX {
+        edge *= 0.25;
+        panels += 1;
+    }
+    panels
+}
+
+/// The fixed quadrature behind [`TranslucentShading::disk_average`] and the Laplacian table of
+/// the far branch, built once per material.
+///
+/// The mean of R_d over a disk D of radius a whose centre is at distance r from x_o is written
+/// in polar coordinates around x_o (not around the disk's centre, where a peaked profile would
+/// sit off-centre and anywhere): (1/πa²) ∫ 2π s φ(s) R_d(s) ds, with φ(s) the fraction of the
+/// circle of radius s around x_o that lies in D (1 for s ≤ a − r; arccos((s² + r² − a²)/(2sr))/π
+/// on |a − r| < s < a + r, the circle–circle intersection angle). The inner part is graded
+/// Gauss–Legendre towards s = 0, the ring part Gauss–Legendre after s = m − h cos τ.
+///
+/// The table holds ∇²R_d/R_d = (R_d'' + R_d'/r)/R_d per channel (1/mm²), by central
+/// differences (step 10⁻³ r) on a geometric grid of [`LAPLACIAN_PER_DECADE`] radii per decade
+/// from 10⁻³ to 10⁴ smallest mean free paths, interpolated linearly in log r; past the radius
+/// holding all but 10⁻⁵ of a channel's reflectance (where R_d is negligible and photon beam
+/// diffusion's spline wiggles about 0) and wherever R_d vanishes the last value is carried
+/// on, and beyond the grid the ends are held.
+#[derive(Clone, Debug)]
+struct DiskRule {
+    /// Nodes on [−1, 1] and weights of one inner panel.
+    inner: Vec<(f64, f64)>,
+    /// (cos τ, weight) of the ring rule on τ ∈ [0, π].
+    ring: Vec<(f64, f64)>,
+    /// Innermost panel edge target (scene units): a quarter of the smallest mean free path.
+    panel_floor: f64,
+    /// ln of the table's first radius (mm).
+    ln_r0: f64,
+    /// Table entries per unit of ln r.
+    per_ln: f64,
+    /// ∇²R_d/R_d per channel at each grid radius (1/mm²).
+    laplacian: Vec<Rgb>,
+}
+
+/// Radii per decade of the Laplacian table of [`DiskRule`].
+const LAPLACIAN_PER_DECADE: f64 = 32.0;
+
+impl DiskRule {
+    fn new(model: &dyn Bssrdf, medium: &sss_bssrdf::Medium, units_per_mm: f64) -> Self {
+        let (x, w) = sss_bssrdf::quadrature::gauss_legendre(DISK_INNER_POINTS);
+        let inner = x.iter().copied().zip(w.iter().copied()).collect();
+        let (x, w) = sss_bssrdf::quadrature::gauss_legendre(DISK_RING_POINTS);
+        let ring = x
+            .iter()
+            .zip(w)
+            .map(|(&x, &w)| ((0.5 * PI * (1.0 + x)).cos(), 0.5 * PI * w))
+            .collect();
+        let mfp_mm = (0..3)
+            .map(|c| 1.0 / medium.sigma_t(c))
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let mfp_mm = if mfp_mm.is_finite() { mfp_mm } else { 1.0 };
+        let u = if units_per_mm.is_finite() && units_per_mm > 0.0 {
+            units_per_mm
+        } else {
+            1.0
+        };
+        let r0 = 1e-3 * mfp_mm;
+        let n = (7.0 * LAPLACIAN_PER_DECADE) as usize + 1;
+        let per_ln = LAPLACIAN_PER_DECADE / std::f64::consts::LN_10;
+        let mut laplacian = Vec::with_capacity(n);
+        // Past the radius holding all but 10⁻⁵ of a channel's reflectance its R_d is negligible
+        // and, for photon beam diffusion, a spline that wiggles about its clamp at 0: the
+        // value there is frozen.
+        let cut: Rgb = [0, 1, 2].map(|c| {
+            let v = model.radius_for_energy(c, 1.0 - 1e-5);
+            if v.is_finite() && v > 0.0 {
+                v
+            } else {
+                f64::INFINITY
+            }
+        });
+        let mut last = [0.0; 3];
+        for k in 0..n {
+            let r = r0 * (k as f64 / per_ln).exp();
+            let h = 1e-3 * r;
+            let (f0, fp, fm) = (model.rd_rgb(r), model.rd_rgb(r + h), model.rd_rgb(r - h));
+            for c in 0..3 {
+                let d2 = (fp[c] - 2.0 * f0[c] + fm[c]) / (h * h);
+                let d1 = (fp[c] - fm[c]) / (2.0 * h);
+                let l = (d2 + d1 / r) / f0[c];
+                if r <= cut[c] && f0[c] > 1e-250 && fp[c] > 0.0 && fm[c] > 0.0 && l.is_finite() {
+                    last[c] = l;
+                }
+            }
+            laplacian.push(last);
+        }
+        DiskRule {
+            inner,
+            ring,
+            panel_floor: 0.25 * mfp_mm * u,
+            ln_r0: r0.ln(),
+            per_ln,
+            laplacian,
+        }
+    }
+
+    /// ∇²R_d/R_d per channel at `r_mm` (1/mm²), interpolated in the table.
+    #[inline]
+    fn laplacian(&self, r_mm: f64) -> Rgb {
+        let last = self.laplacian.len() - 1;
+        let x = if r_mm > 0.0 {
+            ((r_mm.ln() - self.ln_r0) * self.per_ln).clamp(0.0, last as f64)
+        } else {
+            0.0
+        };
+        let i = (x as usize).min(last - 1);
+        let t = x - i as f64;
+        let (lo, hi) = (self.laplacian[i], self.laplacian[i + 1]);
+        [0, 1, 2].map(|c| lo[c] + t * (hi[c] - lo[c]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sss_bssrdf::Medium;
+
+    fn shading(model: ModelKind, medium: Medium, units_per_mm: f64) -> TranslucentShading {
+        TranslucentShading::new(
+            "test",
+            &Translucent {
+                model,
+                medium,
+                units_per_mm,
+                texture: None,
+            },
+        )
+    }
+
+    /// The media of the tests: two measured ones (Jensen et al. 2001) and ketchup, whose green
+    /// and blue channels absorb strongly (σ_tr > σ'_t: the steepest tails).
+    fn media() -> Vec<(&'static str, Medium)> {
+        ["skin1", "marble", "ketchup"]
+            .into_iter()
+            .map(|n| (n, Medium::preset(n).unwrap()))
+            .collect()
+    }
+
+    const RADIAL: [ModelKind; 4] = [
+        ModelKind::StandardDipole,
+        ModelKind::BetterDipole,
+        ModelKind::PhotonBeamDiffusion,
+        ModelKind::Burley,
+    ];
+
+    /// Composite Gauss–Legendre of `f` on [lo, hi]: `panels` equal panels of 12 points, or, with
+    /// `graded`, panels halving towards `lo` (down to 2⁻²⁷ of the interval) for integrands
+    /// that peak there.
+    fn composite(f: &dyn Fn(f64) -> Rgb, lo: f64, hi: f64, panels: usize, graded: bool) -> Rgb {
+        let (x, w) = sss_bssrdf::quadrature::gauss_legendre(12);
+        let mut edges = vec![lo];
+        if graded {
+            for k in (0..28).rev() {
+                edges.push(lo + (hi - lo) * 0.5f64.powi(k));
+            }
+        } else {
+            for k in 1..=panels {
+                edges.push(lo + (hi - lo) * k as f64 / panels as f64);
+            }
+        }
+        let mut sum = [0.0; 3];
+        for e in edges.windows(2) {
+            let (half, mid) = (0.5 * (e[1] - e[0]), 0.5 * (e[1] + e[0]));
+            for (xi, wi) in x.iter().zip(w) {
+                let v = f(mid + half * xi);
+                for c in 0..3 {
+                    sum[c] += wi * half * v[c];
+                }
+            }
+        }
+        sum
+    }
+
+    /// An independent brute force: the mean of R_d over the disk as a double integral over
+    /// the angle θ around x_o (measured from the direction of the disk's centre) and the
+    /// distance s along each ray, between the ray's entry and exit points of the disk
+    /// s± = r cos θ ± √(a² − r² sin² θ), by fine composite Gauss–Legendre in both.
+    fn brute_force(sh: &TranslucentShading, r: f64, a: f64) -> Rgb {
+        let inner = |theta: f64| -> Rgb {
+            let d = (a * a - r * r * theta.sin().powi(2)).max(0.0).sqrt();
+            let (lo, hi) = if r < a {
+                (0.0, r * theta.cos() + d)
+            } else {
+                (r * theta.cos() - d, r * theta.cos() + d)
+            };
+            if !(hi > lo) {
+                return [0.0; 3];
+            }
+            let f = |s: f64| sh.rd_scene(s).map(|v| v * s);
+            composite(&f, lo, hi, 8, lo == 0.0)
+        };
+        let sum = if r < a {
+            // θ over [0, π] (twice, by symmetry); a panel edge at π/2 for the kink at r = a.
+            composite(&inner, 0.0, PI, 12, false)
+        } else {
+            // θ up to the tangent θ_max = asin(a/r); θ = θ_max (1 − (1 − t)²) removes the
+            // square root at the tangent.
+            let tmax = (a / r).min(1.0).asin();
+            let f = |t: f64| {
+                inner(tmax * (1.0 - (1.0 - t) * (1.0 - t))).map(|v| v * 2.0 * tmax * (1.0 - t))
+            };
+            composite(&f, 0.0, 1.0, 12, false)
+        };
+        sum.map(|v| 2.0 * v / (PI * a * a))
+    }
+
+    /// Max over channels of the relative error, ignoring channels whose value is below 10⁻⁶
+    /// of their disk average at r = 0 (no contribution; photon beam diffusion's spline is
+    /// clamped at 0 where it overshoots there, so R_d is not smooth).
+    fn rel_err_floor(got: Rgb, want: Rgb, peak: Rgb) -> f64 {
+        (0..3)
+            .filter(|&c| want[c] > 1e-6 * peak[c])
+            .map(|c| (got[c] - want[c]).abs() / want[c])
+            .fold(0.0, f64::max)
+    }
+
+    /// The disk average against the brute force, every radial model and medium, disk radii of
+    /// 0.1 to 4 smallest reduced mean free paths and r/a ∈ {0, 0.5, 1, 2, 5, 20}.
+    #[test]
+    fn disk_average_matches_brute_force() {
+        let (mut worst, mut worst_large): (f64, f64) = (0.0, 0.0);
+        for model in RADIAL {
+            for (name, medium) in media() {
+                let sh = shading(model, medium.clone(), 0.1);
+                let l = (0..3)
+                    .map(|c| medium.reduced_mean_free_path(c))
+                    .fold(f64::INFINITY, f64::min)
+                    * 0.1;
+                for a_l in [0.1, 0.35, 1.0, 4.0] {
+                    let a = a_l * l;
+                    let peak = brute_force(&sh, 0.0, a);
+                    for ratio in [0.0, 0.5, 1.0, 2.0, 5.0, 20.0] {
+                        let r = ratio * a;
+                        let got = sh.disk_average(r, a);
+                        let want = brute_force(&sh, r, a);
+                        let e = rel_err_floor(got, want, peak);
+                        eprintln!("{model} {name} a/l {a_l} r/a {ratio}: {e:.2e}");
+                        if a_l <= 1.0 {
+                            worst = worst.max(e);
+                        } else {
+                            worst_large = worst_large.max(e);
+                        }
+                    }
+                }
+            }
+        }
+        eprintln!("worst {worst:.3e}, for a = 4 mean free paths {worst_large:.3e}");
+        assert!(worst < 3e-3, "worst relative error {worst}");
+        assert!(worst_large < 2e-2, "worst relative error {worst_large}");
+    }
+
+    /// The far branch's claim: wherever `rd_sample_scene` takes it (r ≥ DISK_FAR_RATIO·a and a
+    /// small correction), it is within 1.5 % of the brute-force disk average; and it is taken at
+    /// the default spacing (disks of ≈ 0.35 reduced mean free paths) from 3 radii on for the
+    /// media that are not strongly absorbing, so `exact` pays for few quadratures.
+    #[test]
+    fn far_branch_is_within_its_tolerance() {
+        let mut worst: f64 = 0.0;
+        for model in RADIAL {
+            for (name, medium) in media() {
+                let sh = shading(model, medium.clone(), 1.0);
+                let l = (0..3)
+                    .map(|c| medium.reduced_mean_free_path(c))
+                    .fold(f64::INFINITY, f64::min);
+                for a_l in [0.05, 0.2, 0.35, 0.5, 1.0, 2.0] {
+                    let a = a_l * l;
+                    let peak = brute_force(&sh, 0.0, a);
+                    let mut far_taken = 0;
+                    for ratio in [DISK_FAR_RATIO, 4.0, 6.0, 8.0, 12.0, 20.0, 40.0] {
+                        let r = ratio * a;
+                        let got = sh.rd_sample_scene(r, PI * a * a);
+                        if got != sh.disk_average(r, a) {
+                            far_taken += 1;
+                        }
+                        let want = brute_force(&sh, r, a);
+                        let e = rel_err_floor(got, want, peak);
+                        eprintln!("far {model} {name} a/l {a_l} r/a {ratio}: {e:.2e}");
+                        worst = worst.max(e);
+                    }
+                    eprintln!("far {model} {name} a/l {a_l}: far branch at {far_taken} of 7");
+                    if a_l <= 0.35 && name != "ketchup" {
+                        assert_eq!(far_taken, 7, "{model} {name} a/l {a_l}");
+                    }
+                }
+            }
+        }
+        eprintln!("far worst {worst:.3e}");
+        assert!(worst < 0.015, "worst relative error {worst}");
+    }
+
+    /// r = 0 has a closed form for normalized diffusion: the disk holds the fraction
+    /// F(a/d) = 1 − ¼e^{−a/d} − ¾e^{−a/(3d)} of the total A (Christensen & Burley 2015, Eq. 11),
+    /// so the mean is A F(a/d)/(πa²).
+    #[test]
+    fn burley_disk_at_the_centre_is_its_cdf() {
+        for (name, medium) in media() {
+            let model = sss_bssrdf::ChristensenBurley::new(medium.clone());
+            let sh = shading(ModelKind::Burley, medium, 1.0);
+            for a in [0.01, 0.1, 0.5, 2.0, 10.0] {
+                let got = sh.rd_sample_scene(0.0, PI * a * a);
+                for c in 0..3 {
+                    let want = model.surface_albedo(c)
+                        * sss_bssrdf::christensen_burley::cdf(a / model.d(c))
+                        / (PI * a * a);
+                    let e = (got[c] - want).abs() / want;
+                    assert!(e < 1e-5, "{name} a {a} channel {c}: {} vs {want}", got[c]);
+                }
+            }
+        }
+    }
+
+    /// Finite and non-negative at r = 0, for zero, tiny, huge and invalid areas and distances;
+    /// a vanishing area gives the point value.
+    #[test]
+    fn finite_everywhere() {
+        for model in RADIAL {
+            let sh = shading(model, Medium::preset("skin1").unwrap(), 0.1);
+            for r in [0.0, 1e-12, 1e-3, 0.1, 1.0, 1e3, 1e300, f64::INFINITY, -0.5] {
+                for area in [
+                    0.0,
+                    1e-300,
+                    1e-12,
+                    1e-4,
+                    1.0,
+                    1e6,
+                    1e300,
+                    f64::INFINITY,
+                    -1.0,
+                    f64::NAN,
+                ] {
+                    let v = sh.rd_sample_scene(r, area);
+                    assert!(
+                        v.iter().all(|x| x.is_finite() && *x >= 0.0),
+                        "{model} r {r} area {area}: {v:?}"
+                    );
+                }
+                assert_eq!(sh.rd_sample_scene(r, 0.0), sh.rd_scene(r.abs()));
+            }
+            // A tiny disk averages to the point value away from a peak.
+            let (p, d) = (sh.rd_scene(0.05), sh.rd_sample_scene(0.05, 1e-12));
+            for c in 0..3 {
+                assert!(
+                    (p[c] - d[c]).abs() <= 1e-6 * p[c],
+                    "{model}: {p:?} vs {d:?}"
+                );
+            }
+        }
+    }
 }

@@ -17,6 +17,7 @@ mod output;
 mod profiles;
 mod reference;
 mod scenes;
+mod subset;
 mod trees;
 
 pub use scenes::default_mesh_dirs;

@@ -11,7 +11,7 @@
 //!    the finest single-tree image.
 //!
 //! Error is measured against `exact` (the point sum both trees approximate, over the same
-//! irradiance samples) on a seeded uniform random subset of [`SUBSET`] translucent pixels:
+//! irradiance samples) on a seeded uniform random subset of [`super::subset::SUBSET_PIXELS`] translucent pixels:
 //! the subset's mean squared error is an unbiased estimate of the whole image's, reported with
 //! its standard error (finite-population corrected). The subset reference is cached like the
 //! scene references.
@@ -19,22 +19,20 @@
 //! Writes `trees.csv`, `trees_error_vs_time.png`, `trees_scaling.png` and `trees/*.png`
 //! under the output directory.
 
-use super::checked::{self, Entry, fnv1a64};
 use super::output::{csv_num, md_num, md_table, write_atomic};
+use super::subset::{SubsetReference, subset_reference};
 use super::{Context, Error, Experiment, Section};
 use sss_bssrdf::Rgb;
 use sss_plot::{PALETTE, Series, SeriesStyle, line_plot, write_error_map};
-use sss_render::frame::Frame;
 use sss_render::integrators::Integrator;
 use sss_render::integrators::dual_tree::DualTree;
-use sss_render::integrators::exact;
+use sss_render::integrators::exact::reference_spacing;
 use sss_render::integrators::single_tree::SingleTree;
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::progress::NoProgress;
 use sss_render::render::{RenderOutput, RenderSettings, render};
 use sss_render::scene::{self, LoadOptions, Scene, SceneErrorKind};
 use std::fmt::Write as _;
-use std::time::Instant;
 
 /// The paper-scale bunny: the full-resolution scan (35 947 vertices, in metres) scaled ×64 to
 /// the built-in bunny's size (about 10 units wide) on its ground, in skin1 with photon beam
@@ -77,12 +75,6 @@ file = "stanford-bunny.obj"
 transform = { scale = [64.0, 64.0, 64.0], translate = [1.078, -2.108, 0.099] }
 "#;
 
-/// Translucent pixels in the subset reference (the issue asks for at least 20 000).
-pub const SUBSET: usize = 20_000;
-
-/// Bumped when the subset reference's meaning or file layout changes.
-const SUBSET_VERSION: u32 = 1;
-
 /// The trees experiment.
 pub struct TreeExperiment;
 
@@ -98,8 +90,6 @@ struct Plan {
     rhos: Vec<f64>,
     /// ε values of the one-thread stage table.
     table_eps: Vec<f64>,
-    /// Translucent pixels in the subset reference.
-    subset: usize,
 }
 
 /// ε of the scaling runs and the ρ sweep.
@@ -116,7 +106,6 @@ fn plan(quick: bool) -> Plan {
             eps: vec![0.2, 0.05, 0.01],
             rhos: vec![0.25, 1.5],
             table_eps: vec![0.2, 0.05],
-            subset: 4000,
         }
     } else {
         Plan {
@@ -125,25 +114,12 @@ fn plan(quick: bool) -> Plan {
             eps: vec![0.2, 0.1, 0.05, 0.02, 0.01],
             rhos: vec![0.25, 0.5, 1.0, 1.5],
             table_eps: vec![0.2, 0.1, 0.05],
-            subset: SUBSET,
         }
     }
 }
 
-/// `exact` at a seeded uniform random subset of the translucent pixels.
-struct SubsetReference {
-    /// Pixel indices, ascending.
-    pixels: Vec<u32>,
-    /// The reference subsurface value of each.
-    values: Vec<Rgb>,
-    /// Translucent pixels in the whole image.
-    population: usize,
-    /// Seconds it took (0 when read from the cache).
-    seconds: f64,
-}
-
 /// An image's error on the subset: RMSE (over pixels and channels) with its standard error,
-/// and the RMSE relative to the reference's root mean square.
+/// and the RMSE relative to the reference's root mean square over the subset.
 #[derive(Clone, Copy, Debug)]
 struct Score {
     rmse: f64,
@@ -151,195 +127,24 @@ struct Score {
     rel_rmse: f64,
 }
 
-fn score(image: &[Rgb], r: &SubsetReference) -> Score {
-    let n = r.pixels.len();
-    let errs: Vec<f64> = r
-        .pixels
-        .iter()
-        .zip(&r.values)
-        .map(|(&p, v)| {
-            let a = image[p as usize];
-            (0..3).map(|c| (a[c] - v[c]).powi(2)).sum::<f64>() / 3.0
-        })
-        .collect();
-    let nf = n.max(1) as f64;
-    let mse = errs.iter().sum::<f64>() / nf;
-    let var = if n > 1 {
-        errs.iter().map(|e| (e - mse).powi(2)).sum::<f64>() / (nf - 1.0)
-    } else {
-        0.0
-    };
-    // Sampling without replacement: the finite-population correction.
-    let fpc = (1.0 - nf / r.population.max(1) as f64).max(0.0);
-    let mse_se = (var / nf * fpc).sqrt();
-    let rmse = mse.sqrt();
+fn score(image: &[Rgb], r: &SubsetReference) -> Result<Score, Error> {
+    let e = r.error(image)?;
+    let n = r.values.len().max(1) as f64;
     let ref_ms = r
         .values
         .iter()
         .map(|v| (0..3).map(|c| v[c] * v[c]).sum::<f64>() / 3.0)
         .sum::<f64>()
-        / nf;
-    Score {
-        rmse,
-        // Delta method: d√m = dm / (2√m).
-        rmse_se: if rmse > 0.0 {
-            mse_se / (2.0 * rmse)
-        } else {
-            0.0
-        },
+        / n;
+    Ok(Score {
+        rmse: e.rmse,
+        rmse_se: e.rmse_se,
         rel_rmse: if ref_ms > 0.0 {
-            rmse / ref_ms.sqrt()
+            e.rmse / ref_ms.sqrt()
         } else {
             0.0
         },
-    }
-}
-
-/// Pixels with a G-buffer sample on a translucent object.
-fn translucent_pixels(frame: &Frame<'_>) -> Vec<u32> {
-    (0..frame.gbuffer.pixels())
-        .filter(|&i| {
-            frame
-                .gbuffer
-                .pixel(i)
-                .iter()
-                .any(|g| frame.shading_of(g.object).is_some())
-        })
-        .map(|i| i as u32)
-        .collect()
-}
-
-/// `k` of `items` chosen uniformly without replacement (partial Fisher–Yates, seeded), sorted.
-fn choose(items: &[u32], k: usize, seed: u64) -> Vec<u32> {
-    let mut v = items.to_vec();
-    let k = k.min(v.len());
-    let mut s = seed;
-    for i in 0..k {
-        s = sss_util::splitmix64(s);
-        let j = i + (s % (v.len() - i) as u64) as usize;
-        v.swap(i, j);
-    }
-    v.truncate(k);
-    v.sort_unstable();
-    v
-}
-
-fn compute_subset(
-    scene: &Scene,
-    seed: u64,
-    settings: &IrradianceSettings,
-    k: usize,
-) -> SubsetReference {
-    use rayon::prelude::*;
-    let t = Instant::now();
-    let frame = Frame::prepare(scene, seed);
-    let population = translucent_pixels(&frame);
-    let pixels = choose(&population, k, sss_util::splitmix64(seed ^ 0x5b5e7));
-    let samples = frame.irradiance_samples(settings);
-    let by_object = frame.samples_by_object(&samples);
-    let spp = f64::from(frame.gbuffer.samples_per_pixel.max(1));
-    let values = pixels
-        .par_iter()
-        .map(|&p| {
-            let mut v = [0.0; 3];
-            for g in frame.gbuffer.pixel(p as usize) {
-                if let (Some(sh), Some(s)) =
-                    (frame.shading_of(g.object), by_object[g.object as usize])
-                {
-                    let x = exact::shade(g, sh, s);
-                    for c in 0..3 {
-                        // As the renderer assembles pixels: non-finite or negative counts as 0.
-                        if x[c].is_finite() && x[c] > 0.0 {
-                            v[c] += x[c] / spp;
-                        }
-                    }
-                }
-            }
-            v
-        })
-        .collect();
-    SubsetReference {
-        pixels,
-        values,
-        population: population.len(),
-        seconds: t.elapsed().as_secs_f64(),
-    }
-}
-
-fn encode(r: &SubsetReference) -> Vec<u8> {
-    let mut b = Vec::with_capacity(16 + r.pixels.len() * 28);
-    b.extend_from_slice(&(r.population as u64).to_le_bytes());
-    b.extend_from_slice(&(r.pixels.len() as u64).to_le_bytes());
-    for (p, v) in r.pixels.iter().zip(&r.values) {
-        b.extend_from_slice(&p.to_le_bytes());
-        for x in v {
-            b.extend_from_slice(&x.to_le_bytes());
-        }
-    }
-    b
-}
-
-fn decode(b: &[u8]) -> Option<SubsetReference> {
-    let u64_at = |o: usize| Some(u64::from_le_bytes(b.get(o..o + 8)?.try_into().ok()?));
-    let population = usize::try_from(u64_at(0)?).ok()?;
-    let n = usize::try_from(u64_at(8)?).ok()?;
-    if b.len() != 16 + n.checked_mul(28)? {
-        return None;
-    }
-    let mut pixels = Vec::with_capacity(n);
-    let mut values = Vec::with_capacity(n);
-    for k in 0..n {
-        let o = 16 + 28 * k;
-        pixels.push(u32::from_le_bytes(b[o..o + 4].try_into().ok()?));
-        let f = |i: usize| f64::from_le_bytes(b[o + 4 + 8 * i..o + 12 + 8 * i].try_into().unwrap());
-        values.push([f(0), f(1), f(2)]);
-    }
-    Some(SubsetReference {
-        pixels,
-        values,
-        population,
-        seconds: 0.0,
     })
-}
-
-/// The cached subset reference of `scene` (keyed by its text, resolution, seed, settings and
-/// subset size).
-fn subset_reference(
-    ctx: &Context<'_>,
-    scene: &Scene,
-    text: &str,
-    settings: &IrradianceSettings,
-    k: usize,
-) -> Result<SubsetReference, Error> {
-    let cfg = ctx.config;
-    let key = fnv1a64(
-        format!(
-            "trees-subset v{SUBSET_VERSION}|{text}|{}x{}|{}|{settings:?}|{k}",
-            scene.camera.width, scene.camera.height, cfg.seed
-        )
-        .as_bytes(),
-    );
-    let dir = cfg.out.join("cache");
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
-    let path = dir.join(format!("trees_subset_{key:016x}.bin"));
-    match checked::check(&path) {
-        Entry::Good(bytes) => {
-            if let Some(r) = decode(&bytes) {
-                return Ok(r);
-            }
-            (ctx.log)(&format!("{}: malformed; recomputing", path.display()));
-        }
-        Entry::Corrupt(why) => (ctx.log)(&format!("{}: {why}; recomputing", path.display())),
-        Entry::Missing => {}
-    }
-    (ctx.log)(&format!(
-        "trees: subset reference ({k} pixels) at {}x{}",
-        scene.camera.width, scene.camera.height
-    ));
-    let r = compute_subset(scene, cfg.seed, settings, k);
-    checked::write_entry(&path, &encode(&r))?;
-    Ok(r)
 }
 
 /// One timed run.
@@ -489,7 +294,11 @@ impl Experiment for TreeExperiment {
             Err(e) => return Err(Error(e.to_string())),
         };
         let p = plan(cfg.quick);
-        let irr = IrradianceSettings::default();
+        // The trees sum over the reference's own irradiance samples.
+        let irr = IrradianceSettings {
+            spacing_mfp: reference_spacing(cfg.quick),
+            ..IrradianceSettings::default()
+        };
         let threads = rayon::current_num_threads();
         let mut runs: Vec<TreeRun> = Vec::new();
         let mut refs: Vec<(u32, SubsetReference)> = Vec::new();
@@ -499,7 +308,7 @@ impl Experiment for TreeExperiment {
         }
         for &res in &resolutions {
             let s = at_resolution(&base, res);
-            refs.push((res, subset_reference(ctx, &s, BUNNY, &irr, p.subset)?));
+            refs.push((res, subset_reference(ctx, &s, BUNNY)?));
         }
         let reference = |res: u32| &refs.iter().find(|r| r.0 == res).expect("computed").1;
         let mut go = |experiment: &'static str,
@@ -517,7 +326,7 @@ impl Experiment for TreeExperiment {
             ));
             let s = at_resolution(&base, res);
             let out = run_on(&s, m, cfg.seed, threads)?;
-            let score = score(&out.subsurface, reference(res));
+            let score = score(&out.subsurface, reference(res))?;
             runs.push(TreeRun {
                 experiment,
                 resolution: res,
@@ -962,75 +771,21 @@ fn report(runs: &[TreeRun], p: &Plan, refs: &[(u32, SubsetReference)], threads: 
 mod tests {
     use super::*;
 
-    fn reference(values: Vec<Rgb>, population: usize) -> SubsetReference {
-        SubsetReference {
-            pixels: (0..values.len() as u32).collect(),
-            values,
-            population,
-            seconds: 0.0,
-        }
-    }
-
     #[test]
     fn score_of_a_known_error() {
-        // Errors of 0.1 in every channel of every pixel: RMSE 0.1, no spread, so SE 0.
-        let r = reference(vec![[1.0; 3]; 10], 100);
-        let img = vec![[1.1; 3]; 10];
-        let s = score(&img, &r);
+        // Errors of 0.1 in every channel of every pixel: RMSE 0.1, no spread, so SE 0; the
+        // reference's RMS is 1, so the relative RMSE is 0.1 too.
+        let r = SubsetReference {
+            pixels: (0..10).collect(),
+            values: vec![[1.0; 3]; 10],
+            population: 100,
+            seconds: 0.0,
+            samples: 0,
+        };
+        let s = score(&vec![[1.1; 3]; 10], &r).unwrap();
         assert!((s.rmse - 0.1).abs() < 1e-12);
         assert!(s.rmse_se.abs() < 1e-12);
         assert!((s.rel_rmse - 0.1).abs() < 1e-12);
-        // The whole population: no sampling error whatever the spread.
-        let r = reference(vec![[1.0; 3], [2.0; 3]], 2);
-        let s = score(&[[1.0; 3], [3.0; 3]], &r);
-        assert!((s.rmse - (0.5f64).sqrt()).abs() < 1e-12);
-        assert_eq!(s.rmse_se, 0.0);
-    }
-
-    #[test]
-    fn subset_mse_is_unbiased_with_its_standard_error() {
-        // A population of squared errors e_i = (i mod 7)²; the subset mean over many seeds
-        // averages to the population mean, and the spread matches the standard error.
-        let n = 5000u32;
-        let image: Vec<Rgb> = (0..n).map(|i| [f64::from(i % 7); 3]).collect();
-        let truth = (0..n).map(|i| f64::from(i % 7).powi(2)).sum::<f64>() / f64::from(n);
-        let all: Vec<u32> = (0..n).collect();
-        let mut means = Vec::new();
-        let mut ses = Vec::new();
-        for seed in 0..200 {
-            let pixels = choose(&all, 500, seed);
-            let r = SubsetReference {
-                values: vec![[0.0; 3]; pixels.len()],
-                pixels,
-                population: n as usize,
-                seconds: 0.0,
-            };
-            let s = score(&image, &r);
-            means.push(s.rmse * s.rmse);
-            ses.push(2.0 * s.rmse * s.rmse_se);
-        }
-        let m = means.iter().sum::<f64>() / means.len() as f64;
-        let sd =
-            (means.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (means.len() - 1) as f64).sqrt();
-        let se = ses.iter().sum::<f64>() / ses.len() as f64;
-        // Mean of 200 estimates: within 4 standard errors of the mean.
-        assert!(
-            (m - truth).abs() < 4.0 * sd / (200f64).sqrt(),
-            "{m} vs {truth}"
-        );
-        // The reported SE matches the observed spread within 15 %.
-        assert!((se / sd - 1.0).abs() < 0.15, "se {se} sd {sd}");
-    }
-
-    #[test]
-    fn choose_draws_distinct_sorted_items() {
-        let items: Vec<u32> = (10..1010).collect();
-        let c = choose(&items, 300, 9);
-        assert_eq!(c.len(), 300);
-        assert!(c.windows(2).all(|w| w[0] < w[1]));
-        assert!(c.iter().all(|x| (10..1010).contains(x)));
-        assert_eq!(choose(&items, 5000, 9).len(), 1000);
-        assert_eq!(c, choose(&items, 300, 9));
     }
 
     #[test]
@@ -1040,20 +795,5 @@ mod tests {
         assert!((t - 10f64.powf(1.5)).abs() < 1e-9);
         assert_eq!(time_at_rmse(&pts, 1e-4), None);
         assert_eq!(time_at_rmse(&pts, 1e-3), Some(100.0));
-    }
-
-    #[test]
-    fn encoded_references_round_trip() {
-        let r = SubsetReference {
-            pixels: vec![3, 9],
-            values: vec![[0.5, 1.0, 2.0], [0.0, 1e-300, 7.0]],
-            population: 11,
-            seconds: 1.0,
-        };
-        let d = decode(&encode(&r)).unwrap();
-        assert_eq!(d.pixels, r.pixels);
-        assert_eq!(d.values, r.values);
-        assert_eq!(d.population, 11);
-        assert!(decode(&encode(&r)[..20]).is_none());
     }
 }

@@ -2,6 +2,16 @@
 //! object of the model's contribution, with no hierarchy and no culling. Ground truth for the
 //! hierarchical methods (single tree, dual tree, many-light) on the same points: their error
 //! against it is the hierarchy's error alone.
+//!
+//! Each sample's R_d is [`TranslucentShading::rd_sample_scene`]: R_d averaged over the
+//! sample's own disk (its area A_i) near the shading point, where peaked profiles would
+//! otherwise let the nearest sample dominate, and the (corrected) point value far away. So
+//! the sum is a good estimate of the surface integral pixel by pixel, not only on average
+//! (per-pixel agreement with `pathtrace`: `tests/disk_average.rs`).
+//!
+//! [`shade_subset`] computes the same values for a subset of pixels only: a reference at
+//! resolutions where shading every pixel would take too long, scored with
+//! [`crate::metrics::subset_error`].
 
 use super::add_scaled;
 use super::{Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep};
@@ -10,6 +20,7 @@ use crate::frame::Frame;
 use crate::gbuffer::GSample;
 use crate::irradiance::{IrradianceSettings, ObjectSamples};
 use crate::progress::Progress;
+use crate::render::assembled_subsurface;
 use crate::shading::TranslucentShading;
 use rayon::prelude::*;
 use sss_bssrdf::{Rgb, SurfacePoint};
@@ -175,4 +186,60 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
     let mut out = [0.0; 3];
     add_scaled(&mut out, sum, shading.exit_weight(g.n, g.wo));
     out
+}
+
+/// The pixels of `frame` with at least one G-buffer sample on a visible translucent object:
+/// the pixels with translucent coverage ([`crate::render::RenderOutput::translucent_pixels`]
+/// of a render of the same frame), in increasing order.
+pub fn translucent_pixels(frame: &Frame<'_>) -> Vec<usize> {
+    let gb = &frame.gbuffer;
+    (0..gb.pixels())
+        .filter(|&i| {
+            gb.pixel(i)
+                .iter()
+                .any(|g| frame.shading_of(g.object).is_some())
+        })
+        .collect()
+}
+
+/// The subsurface values that `exact` with `irradiance` gives the pixels `pixels` of `frame`,
+/// assembled as [`crate::render::render`] assembles them (the mean over the pixel's camera
+/// samples, those off translucent objects counting 0), so equal to the full render's
+/// `subsurface` at those pixels to rounding. Only the listed pixels are shaded; the irradiance
+/// samples are built for every visible translucent object (check their memory first with
+/// [`crate::budget::check_irradiance`]). Shading is timed as stage `shading`. A pixel index
+/// past the image is an error.
+pub fn shade_subset(
+    frame: &Frame<'_>,
+    irradiance: &IrradianceSettings,
+    pixels: &[usize],
+) -> Result<Vec<Rgb>, Error> {
+    let n = frame.gbuffer.pixels();
+    if let Some(&bad) = pixels.iter().find(|&&i| i >= n) {
+        return Err(Error::Input(format!(
+            "subset reference: pixel {bad} is past the image's {n} pixels"
+        )));
+    }
+    let samples = frame.irradiance_samples(irradiance);
+    let by_object = frame.samples_by_object(&samples);
+    let gb = &frame.gbuffer;
+    Ok(frame.timed("shading", || {
+        pixels
+            .par_iter()
+            .map(|&i| {
+                let values: Vec<Option<Rgb>> = gb
+                    .pixel(i)
+                    .iter()
+                    .map(
+                        |g| match (frame.shading_of(g.object), by_object[g.object as usize]) {
+                            (Some(sh), Some(s)) => Some(shade(g, sh, s)),
+                            (Some(_), None) => Some([0.0; 3]),
+                            _ => None,
+                        },
+                    )
+                    .collect();
+                assembled_subsurface(&values, gb.samples_per_pixel)
+            })
+            .collect()
+    }))
 }

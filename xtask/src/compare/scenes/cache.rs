@@ -15,8 +15,8 @@ use sss_render::scene::Scene;
 use std::path::Path;
 
 /// Bumped whenever the reference renderer's output (or the cache layout) changes, to
-/// invalidate cached references. 3: checksum sidecars.
-const REFERENCE_VERSION: u32 = 3;
+/// invalidate cached references. 3: checksum sidecars. 4: disk-averaged R_d near x_o.
+const REFERENCE_VERSION: u32 = 4;
 
 /// The reference method: `exact` at [`reference_spacing`].
 pub fn reference_method(quick: bool) -> Exact {

@@ -14,7 +14,7 @@ mod images;
 mod load;
 mod runs;
 
-pub(super) use cache::reference;
+pub(super) use cache::{reference, reference_method};
 pub use load::default_mesh_dirs;
 pub(super) use load::load_scenes;
 
