@@ -212,7 +212,10 @@ fn pathtrace_agrees_with_exact_on_a_sphere() {
     .unwrap();
     let pt = render(
         &scene,
-        &PathTrace { spp: 256 },
+        &PathTrace {
+            spp: 256,
+            ..PathTrace::default()
+        },
         &RenderSettings {
             seed: 7,
             ..RenderSettings::default()
@@ -260,7 +263,13 @@ fn pathtrace_agrees_with_exact_on_a_sphere() {
 #[test]
 fn renders_are_deterministic() {
     let scene = sphere_scene(ModelKind::StandardDipole);
-    let methods: [&dyn Integrator; 2] = [&Exact::default(), &PathTrace { spp: 2 }];
+    let methods: [&dyn Integrator; 2] = [
+        &Exact::default(),
+        &PathTrace {
+            spp: 2,
+            ..PathTrace::default()
+        },
+    ];
     for method in methods {
         let s = RenderSettings {
             seed: 3,

@@ -1,11 +1,46 @@
 //! Property tests: energy conservation and finiteness over random inputs.
+//!
+//! Reproducible (issue 14): the inputs come from a fixed seed, [`SEED`], so every run tries the
+//! same cases and a failure replays as is; a failing case is also persisted by proptest under
+//! `proptest-regressions/` next to this file (its default), to be committed with the fix. To
+//! explore other inputs, change the seed here (the `PROPTEST_RNG_SEED` environment variable
+//! does not override an explicit configuration).
 
 use proptest::prelude::*;
 use sss_bssrdf::{Medium, ModelKind, make_model};
 use sss_separable::{Kernel2d, Kernel2dSpec, Profile1d, TapPlacement, preintegrated, svd, taps};
 
+/// The seed of every property test in this file.
+const SEED: u64 = 0x5eed_0014;
+
+/// 64 cases from [`SEED`].
+fn config() -> ProptestConfig {
+    ProptestConfig {
+        cases: 64,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(SEED),
+        ..ProptestConfig::default()
+    }
+}
+
+/// The configuration draws the same inputs on every run (two fresh runners agree), and not a
+/// constant: the draws differ from each other.
+#[test]
+fn inputs_are_the_same_every_run() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::TestRunner;
+    let draw = || {
+        let mut runner = TestRunner::new(config());
+        (0..8)
+            .map(|_| (0.0f64..1.0).new_tree(&mut runner).unwrap().current())
+            .collect::<Vec<f64>>()
+    };
+    let (a, b) = (draw(), draw());
+    assert_eq!(a, b);
+    assert!(a.windows(2).any(|w| w[0] != w[1]), "{a:?}");
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(config())]
 
     #[test]
     fn tap_placements_conserve_every_channel(
