@@ -363,7 +363,12 @@ fn degenerate_inputs() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    // A fixed seed, so a failure replays (and CI sees the same cases every run).
+    #![proptest_config(ProptestConfig {
+        cases: 64,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_64),
+        ..ProptestConfig::default()
+    })]
     /// Random triangle soups, radii and caps: the invariants always hold.
     #[test]
     fn random_meshes_keep_the_invariants(
