@@ -133,22 +133,22 @@ impl TranslucentShading {
     /// surface, so this is R_d averaged over a disk of that area (radius a = √(A/π)) centred
     /// at distance r from x_o, in the tangent plane (the planar approximation: the curvature of
     /// the surface over one sample's disk is neglected, as the models neglect it everywhere);
-    /// far from x_o, the point value R_d(r). Every point-sum method (`exact`, the tree leaves)
+    /// far from x_o, the point value R_d(r) with its second-order correction. Every point-sum method (`exact`, the tree leaves)
     /// calls this, so they approximate the same sum.
     ///
     /// - **Near** (r < [`DISK_FAR_RATIO`]·a, or wherever the far branch's correction would
     ///   exceed [`DISK_FAR_MAX_CORRECTION`]): the disk average by a fixed quadrature of at most
     ///   [`DISK_EVALUATIONS_MAX`] evaluations of R_d, written in polar coordinates around x_o
     ///   so that peaked profiles (R_d → ∞ as r → 0) are integrated exactly where they peak;
-    ///   see [`disk_average`](Self::disk_average). Within 0.3 % of a fine brute-force quadrature for every model and
-    ///   r/a for disks of radius up to one reduced mean free path, 2 % up to four
-    ///   (`disk_average_matches_brute_force`).
+    ///   see [`disk_average`](Self::disk_average). Within 0.3 % of a fine brute-force
+    ///   quadrature for every model and r/a for disks of radius up to one reduced mean free
+    ///   path, 2 % up to four (`disk_average_matches_brute_force`).
     /// - **Far**: the mean-value expansion of a smooth function over a disk,
     ///   R_d(r) (1 + (a²/8) ∇²R_d(r)/R_d(r)) + O(a⁴ ∇⁴R_d) (Pólya & Szegő; the Laplacian of a
     ///   radial profile is R_d'' + R_d'/r), with ∇²R_d/R_d from a per-material table
     ///   (built with the model: ∇²R_d/R_d by central differences on a geometric grid of 32
-    ///   radii per decade, interpolated in log r): one R_d evaluation and a table look-up. The correction matters even far
-    ///   away: for an exponential tail e^{−σr} it tends to (σa)²/8, not to 0, so the bare point
+    ///   radii per decade, interpolated in log r): one R_d evaluation and a table look-up.
+    ///   The correction matters even far away: for an exponential tail e^{−σr} it tends to (σa)²/8, not to 0, so the bare point
     ///   value would be off by a constant factor (up to 13 % for ketchup at a = ℓ/2). Taken
     ///   only where the correction is at most [`DISK_FAR_MAX_CORRECTION`], which bounds the
     ///   neglected fourth-order term; within 1.5 % of the brute force for every model and medium
