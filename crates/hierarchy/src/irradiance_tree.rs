@@ -129,20 +129,21 @@ impl IrradianceTree {
                 }
             })
             .collect();
-        let mut sums = vec![Sums::default(); tree.nodes.len()];
-        // Pre-order: children come after their parent, so a reverse pass sees them first.
-        for (k, node) in tree.nodes.iter().enumerate().rev() {
-            let mut s = Sums::default();
-            if node.is_leaf() {
+        let sums = tree.bottom_up(
+            Sums::default(),
+            |node| {
+                let mut s = Sums::default();
                 for p in &points[node.start as usize..node.end as usize] {
                     s.add(&Sums::of(p));
                 }
-            } else {
-                s = sums[node.left as usize];
-                s.add(&sums[node.right as usize]);
-            }
-            sums[k] = s;
-        }
+                s
+            },
+            |l, r| {
+                let mut s = *l;
+                s.add(r);
+                s
+            },
+        );
         let clusters = tree
             .nodes
             .iter()

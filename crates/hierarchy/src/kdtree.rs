@@ -103,6 +103,27 @@ impl<const D: usize> KdTree<D> {
         self.nodes.first()
     }
 
+    /// Per node, a summary of its items computed bottom-up in one reverse pass (children
+    /// come after their parent in pre-order): `leaf(node)` for a leaf, `combine(left, right)`
+    /// for an inner node. With an associative `combine` each node's value equals the one
+    /// computed directly over its range.
+    pub fn bottom_up<T: Copy>(
+        &self,
+        empty: T,
+        leaf: impl Fn(&KdNode<D>) -> T,
+        combine: impl Fn(&T, &T) -> T,
+    ) -> Vec<T> {
+        let mut out = vec![empty; self.nodes.len()];
+        for (k, node) in self.nodes.iter().enumerate().rev() {
+            out[k] = if node.is_leaf() {
+                leaf(node)
+            } else {
+                combine(&out[node.left as usize], &out[node.right as usize])
+            };
+        }
+        out
+    }
+
     /// The item indices of node `n`.
     #[inline]
     pub fn items(&self, n: &KdNode<D>) -> &[u32] {

@@ -112,19 +112,21 @@ impl PixelTree {
     pub fn build(points: &[PixelPoint], leaf_size: usize) -> Self {
         let coords: Vec<[f64; 2]> = points.iter().map(|p| p.screen).collect();
         let tree = KdTree::build(&coords, leaf_size);
-        let mut sums = vec![Sums::EMPTY; tree.nodes.len()];
-        for (k, node) in tree.nodes.iter().enumerate().rev() {
-            let mut s = Sums::EMPTY;
-            if node.is_leaf() {
+        let sums = tree.bottom_up(
+            Sums::EMPTY,
+            |node| {
+                let mut s = Sums::EMPTY;
                 for &i in tree.items(node) {
                     s.add(&Sums::of(&points[i as usize]));
                 }
-            } else {
-                s = sums[node.left as usize];
-                s.add(&sums[node.right as usize]);
-            }
-            sums[k] = s;
-        }
+                s
+            },
+            |l, r| {
+                let mut s = *l;
+                s.add(r);
+                s
+            },
+        );
         let clusters = tree
             .nodes
             .iter()
