@@ -16,7 +16,7 @@
 //! `expm1` so that σ_tr → 0 (albedo → 1) stays accurate. Sampling solves T(r) = (1 − u) T(0)
 //! exactly, starting from a per-channel guide table ([`TailTable`]).
 
-use crate::radial::{ClosedFormTail, TailTable};
+use crate::radial::{ClosedFormTail, TailTable, distance};
 use crate::{Bssrdf, Medium, ModelKind, fresnel};
 
 /// (e^{−σa} − e^{−σb})/σ for b ≥ a ≥ 0, stable as σ → 0 (where it tends to b − a).
@@ -80,7 +80,7 @@ impl ClosedFormTail for Channel {
             return (0.0, 0.0);
         }
         // The expressions of `tail` and `rd`, sharing the distances and exponentials.
-        let (dr, dv) = (r.hypot(self.z_r), r.hypot(self.z_v));
+        let (dr, dv) = (distance(r, self.z_r), distance(r, self.z_v));
         let (er, ev) = ((-self.sigma_tr * dr).exp(), (-self.sigma_tr * dv).exp());
         let gap = (self.z_v - self.z_r) * (self.z_v + self.z_r) / (dv + dr);
         let x = self.sigma_tr * gap;

@@ -325,6 +325,50 @@ mod tests {
     use super::*;
 
     #[test]
+    fn non_negative_row_is_non_negative_and_sampled_exactly() {
+        // A spike: Catmull-Rom overshoots below 0 next to it.
+        let knots = [0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0];
+        let values = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+        let index = KnotIndex::new(&knots).unwrap();
+        let row = SplineRow::new(&index, &values);
+        let grid: Vec<f64> = (0..=4000).map(|k| 4.0 * k as f64 / 4000.0).collect();
+        assert!(grid.iter().any(|&x| row.eval(x) < -1e-3));
+        let limited = row.non_negative();
+        assert!(grid.iter().all(|&x| limited.eval(x) >= 0.0));
+        // Knot values are kept, and segments away from the spike are unchanged.
+        for (x, v) in knots.iter().zip(values) {
+            assert!((limited.eval(*x) - v).abs() < 1e-15);
+        }
+        assert_eq!(limited.eval(3.5), row.eval(3.5));
+        // The running integral is that of the limited spline (quadrature), and sampling
+        // inverts it.
+        let f = |x: f64| limited.eval(x);
+        let cdf = |x: f64| {
+            let mut acc = 0.0;
+            for w in knots.windows(2) {
+                if x > w[0] {
+                    acc += crate::quadrature::integrate(&f, w[0], x.min(w[1]), 8);
+                }
+            }
+            acc
+        };
+        assert!(
+            (limited.total() - cdf(4.0)).abs() < 1e-13,
+            "{}",
+            limited.total()
+        );
+        for u in [0.01, 0.3, 0.5, 0.77, 0.99] {
+            let x = limited.sample(u).unwrap();
+            assert!((cdf(x) / limited.total() - u).abs() < 1e-10, "u {u}: x {x}");
+        }
+        // Limiting never applies to a row that stays non-negative.
+        let smooth = SplineRow::new(&index, &[0.0, 0.4, 0.7, 0.8, 0.7, 0.4, 0.1]);
+        let same = smooth.non_negative();
+        assert!(grid.iter().all(|&x| smooth.eval(x) == same.eval(x)));
+        assert_eq!(smooth.total(), same.total());
+    }
+
+    #[test]
     fn knot_index_equals_bisection() {
         // The PBD grid (0, 2.5e-3 × 1.2^k) and an irregular one.
         let mut pbd = vec![0.0, 2.5e-3];

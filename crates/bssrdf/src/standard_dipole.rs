@@ -17,7 +17,7 @@
 //! internal diffuse Fresnel reflectance ([`crate::fresnel::diffuse_fresnel_reflectance`] at
 //! 1/η) rather than the paper's polynomial fit (they agree to about 1 %).
 
-use crate::radial::{ClosedFormTail, TailTable};
+use crate::radial::{ClosedFormTail, TailTable, distance};
 use crate::{Bssrdf, Medium, ModelKind, fresnel};
 
 /// Per-channel constants of the dipole.
@@ -64,7 +64,7 @@ impl ClosedFormTail for Channel {
         // The same terms as `tail` and `rd`, sharing d and e^{−σ_tr d} per source.
         let (mut tail, mut flux) = (0.0, 0.0);
         for z in [self.z_r, self.z_v] {
-            let d = r.hypot(z);
+            let d = distance(r, z);
             let s = self.sigma_tr * d;
             let e = (-s).exp();
             tail += z / d * e;

@@ -224,7 +224,7 @@ fn pbd_rows_equal_the_tensor_interpolation() {
                 let x = t.max_optical_radius() * (k as f64 / 20_000.0).powi(3);
                 t.interpolate_profile(rho, x).unwrap() < 0.0
             });
-            if negative || !(model.total_diffuse_reflectance(ch) > 0.0) {
+            if negative || model.total_diffuse_reflectance(ch) <= 0.0 {
                 continue;
             }
             compared += 1;
