@@ -50,16 +50,20 @@ fn main() {
         let medium = Medium::preset(preset).expect("preset");
         for kind in ModelKind::ALL {
             let model = make_model(kind, &medium);
+            // Models built per CPU second, after the first build (PBD's shared table of the
+            // medium's (g, η) is cached by then).
+            let builds = rate(1, || make_model(kind, black_box(&medium)).rd(0, 1.0));
             let rd = rate(n, || radii.iter().map(|&r| model.rd(0, black_box(r))).sum());
             let sample = rate(n, || {
                 us.iter().map(|&u| model.sample_sr(0, black_box(u))).sum()
             });
             println!(
-                "{:<8} {:<20} {:>8.1} {:>10.1}",
+                "{:<8} {:<20} {:>8.1} {:>10.1} {:>10.1}",
                 preset,
                 kind.name(),
                 rd * 1e-6,
-                sample * 1e-6
+                sample * 1e-6,
+                1e6 / builds
             );
         }
     }
