@@ -13,9 +13,10 @@
 //! closed form: ∫_r^∞ 2πr' e^{−σd}/d dr' = 2π e^{−σd}/σ and ∫_r^∞ 2πr' z(1+σd)e^{−σd}/d³ dr' =
 //! 2π (z/d) e^{−σd}, so the total diffuse reflectance and the tail mass are exact; at α' = 1
 //! the total is exactly 1. The fluence difference (e^{−σa} − e^{−σb})/σ is evaluated with
-//! `expm1` so that σ_tr → 0 (albedo → 1) stays accurate.
+//! `expm1` so that σ_tr → 0 (albedo → 1) stays accurate. Sampling solves T(r) = (1 − u) T(0)
+//! exactly, starting from a per-channel guide table ([`TailTable`]).
 
-use crate::radial::ClosedFormTail;
+use crate::radial::{ClosedFormTail, TailTable, distance};
 use crate::{Bssrdf, Medium, ModelKind, fresnel};
 
 /// (e^{−σa} − e^{−σb})/σ for b ≥ a ≥ 0, stable as σ → 0 (where it tends to b − a).
@@ -74,6 +75,32 @@ impl ClosedFormTail for Channel {
         2.0 * std::f64::consts::PI * r * self.rd(r)
     }
 
+    fn tail_and_density(&self, r: f64) -> (f64, f64) {
+        if self.alpha_p <= 0.0 {
+            return (0.0, 0.0);
+        }
+        // The expressions of `tail` and `rd`, sharing the distances and exponentials.
+        let (dr, dv) = (distance(r, self.z_r), distance(r, self.z_v));
+        let (er, ev) = ((-self.sigma_tr * dr).exp(), (-self.sigma_tr * dv).exp());
+        let gap = (self.z_v - self.z_r) * (self.z_v + self.z_r) / (dv + dr);
+        let x = self.sigma_tr * gap;
+        let diff = if x < 1e-10 {
+            er * gap
+        } else {
+            -er * (-x).exp_m1() / self.sigma_tr
+        };
+        let a2 = self.alpha_p * self.alpha_p;
+        let tail = a2
+            * (self.c_phi / (2.0 * self.d) * diff
+                + 0.5 * self.c_e * (self.z_r / dr * er + self.z_v / dv * ev));
+        let phi = self.c_phi / self.d * (er / dr - ev / dv).max(0.0);
+        let flux = self.c_e
+            * (self.z_r * (1.0 + self.sigma_tr * dr) * er / (dr * dr * dr)
+                + self.z_v * (1.0 + self.sigma_tr * dv) * ev / (dv * dv * dv));
+        let density = 0.5 * r * a2 * (phi + flux);
+        (tail.max(0.0), density.max(0.0))
+    }
+
     fn total(&self) -> f64 {
         self.total
     }
@@ -88,6 +115,8 @@ impl ClosedFormTail for Channel {
 pub struct BetterDipole {
     medium: Medium,
     ch: [Channel; 3],
+    /// Guide tables for exact fast sampling ([`TailTable`]).
+    tables: [TailTable; 3],
 }
 
 impl BetterDipole {
@@ -116,7 +145,8 @@ impl BetterDipole {
             channel.total = channel.tail(0.0).clamp(0.0, 1.0);
             channel
         });
-        BetterDipole { medium, ch }
+        let tables = std::array::from_fn(|c| TailTable::new(&ch[c]));
+        BetterDipole { medium, ch, tables }
     }
 }
 
@@ -134,12 +164,12 @@ impl Bssrdf for BetterDipole {
         self.ch[ch].total
     }
     fn sample_sr(&self, ch: usize, u: f64) -> f64 {
-        self.ch[ch].sample(u)
+        self.tables[ch].sample(&self.ch[ch], u)
     }
     fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
         self.ch[ch].pdf(r)
     }
     fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64 {
-        self.ch[ch].radius_for_energy(fraction)
+        self.tables[ch].sample(&self.ch[ch], fraction.clamp(0.0, 1.0 - 1e-15))
     }
 }

@@ -123,7 +123,7 @@ pub fn apply_weights(offset: isize, w: &[f64; 4], value: impl Fn(usize) -> f64) 
 
 /// Scaled end derivatives (d₀, d₁) of the spline on interval `i` (pbrt Eq. 8.28, one-sided
 /// differences at the ends of the knot vector).
-fn segment_derivatives(xs: &[f64], f: impl Fn(usize) -> f64, i: usize) -> (f64, f64) {
+pub(crate) fn segment_derivatives(xs: &[f64], f: impl Fn(usize) -> f64, i: usize) -> (f64, f64) {
     let n = xs.len();
     let (x0, x1) = (xs[i], xs[i + 1]);
     let width = x1 - x0;
@@ -274,6 +274,21 @@ pub fn sample_catmull_rom_2d(
     let (d0, d1) = segment_derivatives(nodes2, |k| interp(values, k), idx);
     // Mass to cover inside the interval, in units of f (the interval integral is w ∫₀ᵗ p).
     let target = (u - interp(cdf, idx)) / width;
+    let (t, fval) = invert_segment_integral(f0, f1, d0, d1, target);
+    (x0 + width * t, fval, (fval / maximum).max(0.0))
+}
+
+/// Inverts the integral of one Hermite segment (pbrt Eq. 8.27 with end values `f0`, `f1` and
+/// scaled derivatives `d0`, `d1`): the t ∈ [0, 1] with ∫₀ᵗ p(s) ds = `target`, by
+/// Newton-bisection started from the root of the linear interpolant's integral (pbrt 3rd ed.
+/// §8.6.2 `SampleCatmullRom2D`). Returns (t, p(t)).
+pub(crate) fn invert_segment_integral(
+    f0: f64,
+    f1: f64,
+    d0: f64,
+    d1: f64,
+    target: f64,
+) -> (f64, f64) {
     // Initial guess: invert the integral of the linear interpolant f₀ + (f₁ − f₀) t.
     let t0 = if f0 != f1 {
         (f0 - (f0 * f0 + 2.0 * target * (f1 - f0)).max(0.0).sqrt()) / (f0 - f1)
@@ -295,8 +310,7 @@ pub fn sample_catmull_rom_2d(
     };
     let scale = f0.abs().max(f1.abs()).max(d0.abs()).max(d1.abs());
     let t = newton_bisect(integral, target, t0, scale);
-    let fval = integral(t).1;
-    (x0 + width * t, fval, (fval / maximum).max(0.0))
+    (t, integral(t).1)
 }
 
 #[cfg(test)]

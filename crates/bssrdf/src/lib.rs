@@ -62,6 +62,7 @@ pub mod photon_beam_diffusion;
 pub mod presets;
 pub mod quadrature;
 pub mod radial;
+pub mod spline_row;
 pub mod standard_dipole;
 
 use std::fmt;

@@ -13,11 +13,11 @@
 //!
 //! whose value at r = 0 is Jensen et al.'s total diffuse reflectance
 //! R_d = α'/2 (1 + e^{−(4/3)A√(3(1−α'))}) e^{−√(3(1−α'))}. Sampling solves T(r) = (1−u)T(0)
-//! exactly. F_dr is the exact internal diffuse Fresnel reflectance
-//! ([`crate::fresnel::diffuse_fresnel_reflectance`] at 1/η) rather than the paper's polynomial
-//! fit (they agree to about 1 %).
+//! exactly, starting from a per-channel guide table ([`TailTable`]). F_dr is the exact
+//! internal diffuse Fresnel reflectance ([`crate::fresnel::diffuse_fresnel_reflectance`] at
+//! 1/η) rather than the paper's polynomial fit (they agree to about 1 %).
 
-use crate::radial::ClosedFormTail;
+use crate::radial::{ClosedFormTail, TailTable, distance};
 use crate::{Bssrdf, Medium, ModelKind, fresnel};
 
 /// Per-channel constants of the dipole.
@@ -60,6 +60,23 @@ impl ClosedFormTail for Channel {
         2.0 * std::f64::consts::PI * r * self.rd(r)
     }
 
+    fn tail_and_density(&self, r: f64) -> (f64, f64) {
+        // The same terms as `tail` and `rd`, sharing d and e^{−σ_tr d} per source.
+        let (mut tail, mut flux) = (0.0, 0.0);
+        for z in [self.z_r, self.z_v] {
+            let d = distance(r, z);
+            let s = self.sigma_tr * d;
+            let e = (-s).exp();
+            tail += z / d * e;
+            flux += z * (1.0 + s) * e / (d * d * d);
+        }
+        if self.alpha_p <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let density = 0.5 * r * self.alpha_p * flux;
+        (0.5 * self.alpha_p * tail, density.max(0.0))
+    }
+
     fn total(&self) -> f64 {
         self.total
     }
@@ -74,6 +91,8 @@ impl ClosedFormTail for Channel {
 pub struct StandardDipole {
     medium: Medium,
     ch: [Channel; 3],
+    /// Guide tables for exact fast sampling ([`TailTable`]).
+    tables: [TailTable; 3],
 }
 
 impl StandardDipole {
@@ -94,7 +113,8 @@ impl StandardDipole {
             channel.total = channel.tail(0.0).clamp(0.0, 1.0);
             channel
         });
-        StandardDipole { medium, ch }
+        let tables = std::array::from_fn(|c| TailTable::new(&ch[c]));
+        StandardDipole { medium, ch, tables }
     }
 
     /// The closed-form total diffuse reflectance of Jensen et al. 2001,
@@ -122,12 +142,12 @@ impl Bssrdf for StandardDipole {
         self.ch[ch].total
     }
     fn sample_sr(&self, ch: usize, u: f64) -> f64 {
-        self.ch[ch].sample(u)
+        self.tables[ch].sample(&self.ch[ch], u)
     }
     fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
         self.ch[ch].pdf(r)
     }
     fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64 {
-        self.ch[ch].radius_for_energy(fraction)
+        self.tables[ch].sample(&self.ch[ch], fraction.clamp(0.0, 1.0 - 1e-15))
     }
 }
