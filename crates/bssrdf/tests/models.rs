@@ -38,11 +38,14 @@ fn dipole_totals_equal_quadrature_of_their_profiles_for_every_preset() {
     }
 }
 
+/// One row of [`JENSEN_TABLE2`]: material, R_d as printed for red, green, blue, and the
+/// number of decimals printed for σ'_s and for σ_a of each channel.
+type Table2Row = (&'static str, [f64; 3], [i32; 3], [i32; 3]);
+
 /// Jensen, Marschner, Levoy, Hanrahan, *A Practical Model for Subsurface Light Transport*,
-/// SIGGRAPH 2001, Table 2, typed in again here: (material, R_d as printed for red, green,
-/// blue, and the number of decimals printed for σ'_s and for σ_a of each channel).
+/// SIGGRAPH 2001, Table 2, typed in again here.
 #[rustfmt::skip]
-const JENSEN_TABLE2: [(&str, [f64; 3], [i32; 3], [i32; 3]); 12] = [
+const JENSEN_TABLE2: [Table2Row; 12] = [
     ("apple", [0.85, 0.84, 0.53], [2, 2, 2], [4, 4, 3]),
     ("chicken1", [0.31, 0.15, 0.10], [2, 2, 2], [3, 3, 2]),
     ("chicken2", [0.32, 0.16, 0.10], [2, 2, 2], [3, 3, 2]),
