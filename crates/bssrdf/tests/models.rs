@@ -148,6 +148,31 @@ fn standard_dipole_reproduces_published_reflectances() {
 }
 
 #[test]
+fn separable_directional_factor_is_normalised() {
+    // pbrt 3rd ed. Eq. 11.6-11.7: S = F_t(cos θ_o) R_d F_t(cos θ_i)/(cπ), c = 1 − 2C₁, so that
+    // ∫ F_t(cos θ)/(cπ) cos θ dω = 1. With R_d = 1 and normal incidence, the outgoing
+    // projected integral ∫ S cos θ_o dω_o is therefore F_t(1) = 1 − ((η − 1)/(η + 1))² (Born &
+    // Wolf §1.5.2). Quadrature over μ = cos θ_o (the azimuth gives 2π); F_t is smooth for
+    // η > 1. (cargo-mutants: ft_dielectric → −1 survived, its sign cancelling in F_t·F_t.)
+    for eta in [1.1, 1.3, 1.5, 2.0] {
+        let m = Medium::new([0.1; 3], [1.0; 3], 0.0, eta).unwrap();
+        let f = |mu: f64| sss_bssrdf::separable_s(&m, [1.0; 3], 1.0, mu)[0] * mu;
+        let projected = TWO_PI
+            * (0..16)
+                .map(|k| integrate(&f, k as f64 / 16.0, (k + 1) as f64 / 16.0, 16))
+                .sum::<f64>();
+        let want = 1.0 - ((eta - 1.0) / (eta + 1.0)).powi(2);
+        assert!(
+            (projected - want).abs() < 1e-9,
+            "eta {eta}: {projected} vs {want}"
+        );
+        // Below the surface on either side: nothing.
+        assert_eq!(sss_bssrdf::separable_s(&m, [1.0; 3], -0.2, 0.5), [0.0; 3]);
+        assert_eq!(sss_bssrdf::separable_s(&m, [1.0; 3], 0.5, 0.0), [0.0; 3]);
+    }
+}
+
+#[test]
 fn better_dipole_conserves_energy_at_albedo_one() {
     for eta in [0.75, 1.0, 1.33, 2.5] {
         let m = Medium::new([0.0; 3], [1.0, 10.0, 100.0], 0.0, eta).unwrap();
