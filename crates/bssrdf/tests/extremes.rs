@@ -1,6 +1,7 @@
 //! The stiff and extreme grid: every model and channel stays finite and non-negative.
 
 use proptest::prelude::*;
+use proptest::test_runner::{FileFailurePersistence, RngSeed};
 use sss_bssrdf::*;
 
 const ALBEDOS: [f64; 10] = [
@@ -79,6 +80,36 @@ fn check_model(model: &dyn Bssrdf, label: &str) {
 }
 
 #[test]
+fn fresnel_without_a_valid_interface_reflects_nothing() {
+    // fr_dielectric's guard: an index ratio that is not a positive finite number describes no
+    // interface, so nothing is reflected (as at η = 1) — never NaN, never total reflection.
+    // (cargo-mutants: with the guard's first `||` made `&&`, η = 0 gave 1 and η < 0 a clamped
+    // value; no test noticed.)
+    for eta in [
+        0.0,
+        -0.0,
+        -1.5,
+        -1e-300,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        1.0,
+    ] {
+        for cos in [0.0, 0.3, 1.0, -0.7] {
+            let f = sss_bssrdf::fresnel::fr_dielectric(cos, eta);
+            assert_eq!(f, 0.0, "eta {eta} cos {cos}: {f}");
+            assert_eq!(sss_bssrdf::fresnel::ft_dielectric(cos, eta), 1.0);
+        }
+    }
+    // A valid interface at normal incidence: ((η − 1)/(η + 1))² (Born & Wolf §1.5.2).
+    for eta in [0.5, 1.3, 2.0] {
+        let f = sss_bssrdf::fresnel::fr_dielectric(1.0, eta);
+        let want = ((eta - 1.0) / (eta + 1.0)).powi(2);
+        assert!((f - want).abs() < 1e-15, "eta {eta}: {f} vs {want}");
+    }
+}
+
+#[test]
 fn stiff_and_extreme_grid() {
     let mut checked = 0;
     for &eta in &ETAS {
@@ -105,7 +136,17 @@ fn stiff_and_extreme_grid() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(48))]
+    // Reproducible (issue 14): a fixed seed, so every run draws the same 48 media and a failure
+    // replays as is; a failing case (e.g. found after changing the seed) is also saved under
+    // crates/bssrdf/proptest-regressions/ and replayed first from then on.
+    #![proptest_config(ProptestConfig {
+        cases: 48,
+        rng_seed: RngSeed::Fixed(0x1455_5eed),
+        failure_persistence: Some(Box::new(FileFailurePersistence::SourceParallel(
+            "proptest-regressions",
+        ))),
+        ..ProptestConfig::default()
+    })]
     #[test]
     fn random_valid_media_stay_physical(
         la in -3.0f64..3.0, ls in -3.0f64..3.0, g in -0.95f64..0.95, eta in 0.6f64..3.0,

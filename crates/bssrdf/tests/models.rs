@@ -38,25 +38,137 @@ fn dipole_totals_equal_quadrature_of_their_profiles_for_every_preset() {
     }
 }
 
+/// One row of [`JENSEN_TABLE2`]: material, R_d as printed for red, green, blue, and the
+/// number of decimals printed for σ'_s and for σ_a of each channel.
+type Table2Row = (&'static str, [f64; 3], [i32; 3], [i32; 3]);
+
+/// Jensen, Marschner, Levoy, Hanrahan, *A Practical Model for Subsurface Light Transport*,
+/// SIGGRAPH 2001, Table 2, typed in again here.
+#[rustfmt::skip]
+const JENSEN_TABLE2: [Table2Row; 12] = [
+    ("apple", [0.85, 0.84, 0.53], [2, 2, 2], [4, 4, 3]),
+    ("chicken1", [0.31, 0.15, 0.10], [2, 2, 2], [3, 3, 2]),
+    ("chicken2", [0.32, 0.16, 0.10], [2, 2, 2], [3, 3, 2]),
+    ("cream", [0.98, 0.90, 0.73], [2, 2, 2], [4, 4, 4]),
+    ("ketchup", [0.16, 0.01, 0.00], [2, 2, 2], [3, 2, 2]),
+    ("marble", [0.83, 0.79, 0.75], [2, 2, 2], [4, 4, 4]),
+    ("potato", [0.77, 0.62, 0.21], [2, 2, 2], [4, 4, 2]),
+    ("skimmilk", [0.81, 0.81, 0.69], [2, 2, 2], [4, 4, 4]),
+    ("skin1", [0.44, 0.22, 0.13], [2, 2, 2], [3, 2, 2]),
+    ("skin2", [0.63, 0.44, 0.34], [2, 2, 2], [3, 3, 3]),
+    ("spectralon", [1.00, 1.00, 1.00], [1, 1, 1], [2, 2, 2]),
+    ("wholemilk", [0.91, 0.88, 0.76], [2, 2, 2], [4, 4, 3]),
+];
+
+/// The printed R_d values that the paper's own formula (Jensen et al. 2001, the total below
+/// Eq. 5, with their F_dr fit, Eq. 7) does not give for the printed coefficients, beyond the
+/// rounding tolerance: (material, channel, the formula's value for the printed coefficients,
+/// computed by hand from the paper's equations). Table 2 does not say how R_d was obtained;
+/// for these entries it is not the formula's output.
+const TABLE2_INCONSISTENT: [(&str, usize, f64); 5] = [
+    ("chicken1", 2, 0.1264),
+    ("marble", 0, 0.8665),
+    ("marble", 1, 0.8338),
+    ("marble", 2, 0.8010),
+    ("skimmilk", 2, 0.6823),
+];
+
+/// Jensen et al. 2001's total diffuse reflectance of the dipole (below their Eq. 5) for
+/// reduced scattering `s`, absorption `a` and internal diffuse Fresnel reflectance `f_dr`.
+fn jensen_rd(s: f64, a: f64, f_dr: f64) -> f64 {
+    let big_a = (1.0 + f_dr) / (1.0 - f_dr);
+    let alpha_p = s / (s + a);
+    let x = (3.0 * (1.0 - alpha_p)).max(0.0).sqrt();
+    0.5 * alpha_p * (1.0 + (-(4.0 / 3.0) * big_a * x).exp()) * (-x).exp()
+}
+
 #[test]
 fn standard_dipole_reproduces_published_reflectances() {
-    // Jensen et al. 2001 Table 2 lists measured R_d next to the fitted coefficients; the
-    // dipole computed from those coefficients (η = 1.3) must come back close to it. (Our F_dr
-    // is exact rather than the paper's fit, and the published values are measurements with two
-    // digits; marble's blue channel is the largest gap, 0.801 against 0.75.)
-    for p in PRESETS.iter() {
-        let m = Medium::preset(p.name).unwrap();
+    // Each printed R_d of Jensen et al. 2001 Table 2 is its own assertion with its own
+    // tolerance, the sum of:
+    // - 0.005: R_d is printed with two decimals;
+    // - the change of R_d (the paper's formula) over the rounding box of the printed
+    //   coefficients, half a unit of their last printed digit (σ_a ≥ 0: spectralon's 0.00);
+    // - the change of R_d when F_dr moves by 1 %, the accuracy Egan & Hilgeman's fit (the
+    //   paper's Eq. 7) has against the exact F_dr the crate uses.
+    // This is 0.0053-0.015 for every value except spectralon (0.07-0.10, from σ_a = 0.00).
+    // For the five entries of TABLE2_INCONSISTENT the tolerance is widened by the distance
+    // between the printed value and the formula's value for the printed coefficients.
+    // A 10 % change of z_v moves R_d by 1-3.5 % (0.01-0.03 on the bright materials): several
+    // values fail.
+    let f_fit = {
+        let eta: f64 = presets::PRESET_ETA;
+        -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
+    };
+    let mut failures = Vec::new();
+    for (name, published, s_dec, a_dec) in JENSEN_TABLE2 {
+        let preset = presets::find(name).unwrap();
+        // The crate's copy of the table is the paper's.
+        assert_eq!(preset.published_rd, published, "{name}: published R_d");
+        let m = Medium::preset(name).unwrap();
         let sd = make_model(ModelKind::StandardDipole, &m);
         for ch in 0..3 {
+            let (s, a) = (preset.sigma_s_reduced[ch], preset.sigma_a[ch]);
+            let (hs, ha) = (0.5 * 10f64.powi(-s_dec[ch]), 0.5 * 10f64.powi(-a_dec[ch]));
+            let centre = jensen_rd(s, a, f_fit);
+            let mut coef = 0.0f64;
+            for (ds, da) in [(-hs, -ha), (-hs, ha), (hs, -ha), (hs, ha)] {
+                let v = jensen_rd(s + ds, (a + da).max(0.0), f_fit);
+                coef = coef.max((v - centre).abs());
+            }
+            let fit = (jensen_rd(s, a, 1.01 * f_fit) - centre)
+                .abs()
+                .max((jensen_rd(s, a, 0.99 * f_fit) - centre).abs());
+            let mut tol = 0.005 + coef + fit;
+            if let Some((_, _, formula)) = TABLE2_INCONSISTENT
+                .iter()
+                .find(|(n, c, _)| *n == name && *c == ch)
+            {
+                // The hand value is the formula's (to its four printed decimals) ...
+                assert!((formula - centre).abs() < 6e-5, "{name} ch{ch}: {centre}");
+                // ... and outside the rounding tolerance of the printed R_d.
+                assert!((formula - published[ch]).abs() > tol, "{name} ch{ch}");
+                tol += (formula - published[ch]).abs();
+            }
             let ours = sd.total_diffuse_reflectance(ch);
-            let diff = (ours - p.published_rd[ch]).abs();
-            assert!(
-                diff <= 0.055,
-                "{} ch{ch}: {ours} vs published {}",
-                p.name,
-                p.published_rd[ch]
+            let diff = ours - published[ch];
+            println!(
+                "{name} ch{ch}: {ours:.4} vs published {:.2} ({diff:+.4}, tolerance {tol:.4})",
+                published[ch]
             );
+            if diff.abs() > tol {
+                failures.push(format!(
+                    "{name} ch{ch}: R_d {ours:.4} vs published {:.2} ± {tol:.4}",
+                    published[ch]
+                ));
+            }
         }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn separable_directional_factor_is_normalised() {
+    // pbrt 3rd ed. Eq. 11.6-11.7: S = F_t(cos θ_o) R_d F_t(cos θ_i)/(cπ), c = 1 − 2C₁, so that
+    // ∫ F_t(cos θ)/(cπ) cos θ dω = 1. With R_d = 1 and normal incidence, the outgoing
+    // projected integral ∫ S cos θ_o dω_o is therefore F_t(1) = 1 − ((η − 1)/(η + 1))² (Born &
+    // Wolf §1.5.2). Quadrature over μ = cos θ_o (the azimuth gives 2π); F_t is smooth for
+    // η > 1. (cargo-mutants: ft_dielectric → −1 survived, its sign cancelling in F_t·F_t.)
+    for eta in [1.1, 1.3, 1.5, 2.0] {
+        let m = Medium::new([0.1; 3], [1.0; 3], 0.0, eta).unwrap();
+        let f = |mu: f64| sss_bssrdf::separable_s(&m, [1.0; 3], 1.0, mu)[0] * mu;
+        let projected = TWO_PI
+            * (0..16)
+                .map(|k| integrate(&f, k as f64 / 16.0, (k + 1) as f64 / 16.0, 16))
+                .sum::<f64>();
+        let want = 1.0 - ((eta - 1.0) / (eta + 1.0)).powi(2);
+        assert!(
+            (projected - want).abs() < 1e-9,
+            "eta {eta}: {projected} vs {want}"
+        );
+        // Below the surface on either side: nothing.
+        assert_eq!(sss_bssrdf::separable_s(&m, [1.0; 3], -0.2, 0.5), [0.0; 3]);
+        assert_eq!(sss_bssrdf::separable_s(&m, [1.0; 3], 0.5, 0.0), [0.0; 3]);
     }
 }
 
