@@ -111,8 +111,8 @@ fn plan(quick: bool) -> Plan {
         Plan {
             resolutions: vec![256, 512, 1024, 2048],
             sweep_resolution: 1024,
-            eps: vec![0.2, 0.1, 0.05, 0.02, 0.01],
-            rhos: vec![0.25, 0.5, 1.0, 1.5],
+            eps: vec![0.2, 0.1, 0.05, 0.01],
+            rhos: vec![0.25, 0.5, 1.5],
             table_eps: vec![0.2, 0.1, 0.05],
         }
     }
@@ -364,13 +364,14 @@ impl Experiment for TreeExperiment {
                 threads,
             )?;
         }
-        // 2. Table 1 on one thread.
+        // 2. Table 1 on one thread: the dual tree at each ε (as the paper), the single tree at
+        // the middle one for comparison.
         for &eps in &p.table_eps {
-            go("table1", sr, &single(eps), eps, None, 1)?;
             go("table1", sr, &dual(eps, RHO), eps, Some(RHO), 1)?;
         }
-        // 3. Scaling.
-        for &res in &p.resolutions {
+        go("table1", sr, &single(FIXED_EPS), FIXED_EPS, None, 1)?;
+        // 3. Scaling (the sweep resolution's runs at FIXED_EPS are the sweep's own).
+        for &res in p.resolutions.iter().filter(|&&r| r != sr) {
             go("scaling", res, &single(FIXED_EPS), FIXED_EPS, None, threads)?;
             go(
                 "scaling",
@@ -386,6 +387,16 @@ impl Experiment for TreeExperiment {
         plots(ctx, &runs, &p)?;
         Ok(report(&runs, &p, &refs, threads))
     }
+}
+
+/// A run of the scaling series: the scaling runs, and the sweep's runs at [`FIXED_EPS`] and
+/// ρ = [`RHO`] (the series' point at the sweep resolution).
+fn is_scaling(r: &TreeRun, p: &Plan) -> bool {
+    r.experiment == "scaling"
+        || (r.experiment == "eps"
+            && r.resolution == p.sweep_resolution
+            && r.eps == FIXED_EPS
+            && r.rho.is_none_or(|x| x == RHO))
 }
 
 fn pictures(ctx: &Context<'_>, runs: &[TreeRun], res: u32) -> Result<(), Error> {
@@ -532,10 +543,13 @@ fn plots(ctx: &Context<'_>, runs: &[TreeRun], p: &Plan) -> Result<(), Error> {
     )
     .map_err(pe)?;
     let scaling = |method: &str| -> Vec<(f64, f64)> {
-        runs.iter()
-            .filter(|r| r.experiment == "scaling" && r.method == method)
+        let mut v: Vec<(f64, f64)> = runs
+            .iter()
+            .filter(|r| is_scaling(r, p) && r.method == method)
             .map(|r| (f64::from(r.resolution).powi(2), r.stage("shading")))
-            .collect()
+            .collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v
     };
     line_plot(
         &out.join("trees_scaling.png"),
@@ -704,9 +718,10 @@ fn report(runs: &[TreeRun], p: &Plan, refs: &[(u32, SubsetReference)], threads: 
         body,
         "\n#### Scaling with the pixel count (ε = {FIXED_EPS}, ρ = {RHO}, {threads} threads)\n"
     );
-    let rows: Vec<Vec<String>> = runs
+    let mut scaling_runs: Vec<&TreeRun> = runs.iter().filter(|r| is_scaling(r, p)).collect();
+    scaling_runs.sort_by_key(|r| (r.resolution, r.method));
+    let rows: Vec<Vec<String>> = scaling_runs
         .iter()
-        .filter(|r| r.experiment == "scaling")
         .map(|r| {
             vec![
                 format!("{}²", r.resolution),
@@ -732,7 +747,7 @@ fn report(runs: &[TreeRun], p: &Plan, refs: &[(u32, SubsetReference)], threads: 
     let growth = |method: &str| {
         let sh = |res: u32| {
             runs.iter()
-                .find(|r| r.experiment == "scaling" && r.method == method && r.resolution == res)
+                .find(|r| is_scaling(r, p) && r.method == method && r.resolution == res)
                 .map(|r| r.stage("shading"))
         };
         let (lo, hi) = (p.resolutions.first()?, p.resolutions.last()?);
