@@ -30,7 +30,8 @@ fn temp_dir(name: &str) -> PathBuf {
 /// Cheap options per method (as in the integrator contract test).
 fn cheap(name: &str) -> MethodOptions {
     match name {
-        "exact" => MethodOptions::new().with("spacing", 2.0),
+        // The point-based methods on the same (coarse) irradiance samples.
+        "exact" | "single-tree" | "dual-tree" => MethodOptions::new().with("spacing", 2.0),
         "pathtrace" => MethodOptions::new().with("spp", 2),
         _ => MethodOptions::new(),
     }
