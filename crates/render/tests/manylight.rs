@@ -276,3 +276,39 @@ fn vpls_carry_the_lights_power() {
     // The point light is one VPL of its intensity.
     assert_eq!(vpls.len(), 4097);
 }
+
+#[test]
+fn every_radial_model_and_light_kind_of_picnic_renders() {
+    // Picnic with the apple's directional dipole swapped for the better dipole: standard
+    // dipole, PBD (a tabulated profile: its monotonicity check must pass) and better dipole,
+    // under a point and an environment light; every value finite and ≥ 0, every object lit.
+    let mut s = scene("picnic", 32, 24);
+    for m in &mut s.materials {
+        if let sss_scene::MaterialKind::Translucent(t) = &mut m.kind
+            && t.model == sss_bssrdf::ModelKind::DirectionalDipole
+        {
+            t.model = sss_bssrdf::ModelKind::BetterDipole;
+        }
+    }
+    let m = integrators::build(
+        "manylight",
+        &MethodOptions::new().with("eps", 0.1).with("vpls", 64),
+    )
+    .unwrap();
+    let out = render(&s, m.as_ref(), &RenderSettings::default(), &NoProgress).unwrap();
+    let stat = |n: &str| out.stats.iter().find(|s| s.name == n).unwrap().value;
+    assert_eq!(stat("vpls"), 65.0, "1 point + 64 environment VPLs");
+    let frame = Frame::prepare(&s, 1);
+    let mut lit = vec![false; s.objects.len()];
+    for g in &frame.gbuffer.samples {
+        let v = out.subsurface[g.pixel as usize];
+        assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "{v:?}");
+        if frame.shading_of(g.object).is_some() && v.iter().any(|x| *x > 0.0) {
+            lit[g.object as usize] = true;
+        }
+    }
+    for &o in &frame.visible {
+        assert!(lit[o as usize], "object {} unlit", s.objects[o as usize].name);
+    }
+    assert!(stat("pixels_converged") > 0.5 * stat("pixel_estimates"));
+}
