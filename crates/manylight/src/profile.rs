@@ -18,6 +18,10 @@ pub fn luminance(c: [f64; 3]) -> f64 {
 type RdFn = dyn Fn(f64) -> [f64; 3] + Send + Sync;
 type FtFn = dyn Fn(f64) -> f64 + Send + Sync;
 
+/// The absolute rise, relative to the profile's peak, that
+/// [`RadialProfile::with_tolerance`] accepts on top of its relative tolerance.
+pub const PROFILE_ABS_TOL: f64 = 1e-9;
+
 /// Number of radii at which [`RadialProfile::new`] checks the profile.
 pub const PROFILE_CHECK_POINTS: usize = 4096;
 
@@ -33,6 +37,8 @@ pub struct RadialProfile {
     f: Box<RdFn>,
     /// 1 + the accepted relative rise ([`RadialProfile::with_tolerance`]); 1 for [`RadialProfile::new`].
     bound_factor: f64,
+    /// The accepted absolute rise ([`RadialProfile::with_tolerance`]); 0 for [`RadialProfile::new`].
+    bound_floor: f64,
 }
 
 impl std::fmt::Debug for RadialProfile {
@@ -81,16 +87,19 @@ impl RadialProfile {
         Ok(RadialProfile {
             f: Box::new(rd),
             bound_factor: 1.0,
+            bound_floor: 0.0,
         })
     }
 
     /// Like [`RadialProfile::new`] for profiles that are non-increasing only up to a relative
     /// wobble `tol` (tabulated or fitted profiles, e.g. the photon beam diffusion table, which
     /// rises by 0.07 % near r = 0): on the same radii, every value must be at most (1 + tol)
-    /// times the **running minimum** of the smaller radii, i.e. R_d(r) ≤ (1 + tol) R_d(r') for
-    /// all checked r ≥ r'. [`RadialProfile::max_channel`] is then multiplied by (1 + tol), so it
-    /// stays an upper bound of R_d beyond any radius (on the checked radii; the bounds are as
-    /// loose as the tolerance). `tol` in [0, 1).
+    /// times the **running minimum** of the smaller radii plus [`PROFILE_ABS_TOL`] times the
+    /// profile's peak (tails far below the peak wobble by rounding: PBD's blue channel rises by
+    /// 7 % at 1e-10, 3e-15 of its peak), i.e. R_d(r) ≤ (1 + tol) R_d(r') + floor for all checked
+    /// r ≥ r'. [`RadialProfile::max_channel`] is then (1 + tol) max_c R_d,c(r) + floor, an upper
+    /// bound of R_d beyond any radius (on the checked radii; the bounds are as loose as the
+    /// tolerance). `tol` in [0, 1).
     pub fn with_tolerance<F>(rd: F, r_scale: f64, tol: f64) -> Result<Self, Error>
     where
         F: Fn(f64) -> [f64; 3] + Send + Sync + 'static,
@@ -105,19 +114,29 @@ impl RadialProfile {
                 "profile tolerance {tol} must be in [0, 1)"
             )));
         }
-        let mut run_min = [f64::INFINITY; 3];
-        for k in 0..PROFILE_CHECK_POINTS {
-            let t = k as f64 / (PROFILE_CHECK_POINTS - 1) as f64;
-            let r = 4.0 * r_scale * t * t;
-            let v = rd(r);
-            for c in 0..3 {
-                if !(v[c].is_finite() && v[c] >= 0.0) {
+        let radii: Vec<f64> = (0..PROFILE_CHECK_POINTS)
+            .map(|k| {
+                let t = k as f64 / (PROFILE_CHECK_POINTS - 1) as f64;
+                4.0 * r_scale * t * t
+            })
+            .collect();
+        let values: Vec<[f64; 3]> = radii.iter().map(|&r| rd(r)).collect();
+        let mut peak = 0.0f64;
+        for (v, r) in values.iter().zip(&radii) {
+            for (c, x) in v.iter().enumerate() {
+                if !(x.is_finite() && *x >= 0.0) {
                     return Err(Error::InvalidModel(format!(
-                        "R_d({r}) channel {c} = {} is not finite and non-negative",
-                        v[c]
+                        "R_d({r}) channel {c} = {x} is not finite and non-negative"
                     )));
                 }
-                if v[c] > run_min[c] * (1.0 + tol) {
+                peak = peak.max(*x);
+            }
+        }
+        let floor = PROFILE_ABS_TOL * peak;
+        let mut run_min = [f64::INFINITY; 3];
+        for (v, r) in values.iter().zip(&radii) {
+            for c in 0..3 {
+                if v[c] > run_min[c] * (1.0 + tol) + floor {
                     return Err(Error::InvalidModel(format!(
                         "R_d is not non-increasing within a relative {tol}: channel {c} rises \
                          from {} to {} at r = {r}; the many-light bounds need a monotone radial \
@@ -131,6 +150,7 @@ impl RadialProfile {
         Ok(RadialProfile {
             f: Box::new(rd),
             bound_factor: 1.0 + tol,
+            bound_floor: floor,
         })
     }
 
@@ -140,13 +160,13 @@ impl RadialProfile {
         (self.f)(r.max(0.0))
     }
 
-    /// The channel maximum max_c R_d,c(r) (times 1 + tol for a profile built
+    /// The channel maximum max_c R_d,c(r) (times 1 + tol, plus the floor, for a profile built
     /// [`with_tolerance`](RadialProfile::with_tolerance)): the scalar upper bound of
     /// `Σ_c w_c I_c R_d,c(r') / Σ_c w_c I_c` for any non-negative weights and r' ≥ r.
     #[inline]
     pub fn max_channel(&self, r: f64) -> f64 {
         let v = self.eval(r);
-        v[0].max(v[1]).max(v[2]) * self.bound_factor
+        v[0].max(v[1]).max(v[2]) * self.bound_factor + self.bound_floor
     }
 }
 
