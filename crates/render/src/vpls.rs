@@ -101,7 +101,7 @@ pub fn scene_vpls(
                 // the quad and stratified in both directions when m has a good factorisation.
                 let nu = (1..=((m as f64).sqrt() as usize).max(1))
                     .rev()
-                    .find(|d| m % d == 0)
+                    .find(|d| m.is_multiple_of(*d))
                     .unwrap_or(1);
                 let nv = m / nu;
                 let s = area / m as f64;

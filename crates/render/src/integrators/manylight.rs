@@ -32,7 +32,9 @@
 //! textures (the estimator's irradiance has no texture factor).
 
 use super::single_tree::check_radial;
-use super::{Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep};
+use super::{
+    Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
+};
 use crate::Error;
 use crate::frame::Frame;
 use crate::progress::Progress;
@@ -326,7 +328,8 @@ impl Integrator for ManyLight {
 
     fn structure_bytes(&self, scene: &Scene, _samples: &[(usize, u64, u64)]) -> u64 {
         let n = vpl_count(&scene.lights, self.vpls);
-        let lights = n * size_of::<Vpl>() as u64 + (2 * n).saturating_sub(1) * size_of::<LightNode>() as u64;
+        let lights =
+            n * size_of::<Vpl>() as u64 + (2 * n).saturating_sub(1) * size_of::<LightNode>() as u64;
         let triangles: u64 = (0..scene.objects.len())
             .filter(|&o| scene.translucent(o).is_some())
             .map(|o| scene.objects[o].mesh.triangles.len() as u64)
@@ -423,10 +426,12 @@ impl Integrator for ManyLight {
                             if !(e_sum > 0.0) {
                                 continue;
                             }
-                            let tree = ShadingTree::new(points)
-                                .map_err(|e| model_error(scene, o, e))?;
+                            let tree =
+                                ShadingTree::new(points).map_err(|e| model_error(scene, o, e))?;
                             let seed = pixel_seed(
-                                sss_util::splitmix64(frame.seed ^ sss_util::splitmix64(u64::from(o))),
+                                sss_util::splitmix64(
+                                    frame.seed ^ sss_util::splitmix64(u64::from(o)),
+                                ),
                                 i as u64,
                             );
                             let px = est.estimate_with(&tree, &visibility, seed, refs);
