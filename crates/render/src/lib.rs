@@ -79,6 +79,7 @@ pub mod progress;
 pub mod render;
 pub mod rng;
 pub mod shading;
+pub mod vpls;
 
 pub use error::Error;
 /// The scene format (re-exported from `sss-scene`).

@@ -19,6 +19,8 @@ pub enum Stream {
     Opaque = 4,
     /// Blue-noise sample placement (per object).
     Placement = 5,
+    /// Virtual point lights sampled on area and environment lights (per light).
+    Vpl = 6,
 }
 
 /// The generator for work item `index` of `stream` under `seed`.

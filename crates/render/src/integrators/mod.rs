@@ -23,6 +23,7 @@
 
 pub mod dual_tree;
 pub mod exact;
+pub mod manylight;
 pub mod options;
 pub mod pathtrace;
 pub mod separable;
@@ -131,6 +132,7 @@ pub const METHODS: &[Method] = &[
     separable::METHOD,
     single_tree::METHOD,
     dual_tree::METHOD,
+    manylight::METHOD,
 ];
 
 /// The registry entry named `name`.

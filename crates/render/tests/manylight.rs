@@ -1,0 +1,323 @@
+//! The `manylight` integrator against an independent brute force over the same light, its
+//! caps and refusals, and the VPLs it is built on (closed forms of their total power).
+
+use glam::DVec3;
+use sss_bssrdf::fresnel::ft_dielectric;
+use sss_bssrdf::{fresnel_normalization, make_model};
+use sss_manylight::StudentT;
+use sss_render::frame::Frame;
+use sss_render::integrators::{self, MethodOptions};
+use sss_render::progress::NoProgress;
+use sss_render::render::{RenderSettings, render};
+use sss_render::scene::{LoadOptions, Scene, builtin};
+use sss_render::vpls::{DISTANT_FACTOR, scene_vpls};
+use sss_scene::Light;
+use std::f64::consts::PI;
+
+const LUM: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+fn lum(c: [f64; 3]) -> f64 {
+    LUM[0] * c[0] + LUM[1] * c[1] + LUM[2] * c[2]
+}
+
+fn scene(name: &str, w: u32, h: u32) -> Scene {
+    let mut s = builtin(name, &LoadOptions::default()).unwrap();
+    s.camera.width = w;
+    s.camera.height = h;
+    s
+}
+
+/// Brute force of the sphere scene's subsurface image, written independently of the
+/// integrator: per G-buffer sample x_o, F_t(η, n·ω_o)/(cπ) Σ over the mesh triangles of
+/// R_d(‖x − x_o‖) I cos θ_i/d² F_t(η, cos θ_i) dA by the centroid rule on each triangle cut
+/// into 4^L parts (L = 4 within 0.15 units of x_o, 3 within 0.5, 1 beyond), with no shadow
+/// rays: the sphere is convex and alone, so a face is lit iff it faces the light.
+fn brute_force_sphere(scene: &Scene, frame: &Frame<'_>) -> Vec<[f64; 3]> {
+    let t = scene.translucent(0).unwrap();
+    let model = make_model(t.model, &t.medium);
+    let u = t.units_per_mm;
+    let eta = t.medium.eta();
+    let norm = 1.0 / (fresnel_normalization(eta) * PI);
+    let Light::Point {
+        position: light,
+        intensity,
+    } = scene.lights[0]
+    else {
+        panic!("sphere has one point light")
+    };
+    let mesh = &scene.objects[0].mesh;
+    let tris: Vec<[DVec3; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| mesh.positions[i as usize]))
+        .collect();
+    // E(x) F_t at the centroid of each part, for parts at every level, computed once.
+    let gb = &frame.gbuffer;
+    let spp = gb.samples_per_pixel as f64;
+    let mut out = vec![[0.0; 3]; gb.pixels()];
+    for g in &gb.samples {
+        let exit = ft_dielectric(g.n.dot(g.wo), eta) * norm / spp;
+        let mut sum = [0.0; 3];
+        for tri in &tris {
+            let c = (tri[0] + tri[1] + tri[2]) / 3.0;
+            let dist = c.distance(g.p);
+            let level = if dist < 0.15 {
+                4
+            } else if dist < 0.5 {
+                3
+            } else {
+                1
+            };
+            let nrm = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+            let area = 0.5 * nrm.length();
+            let n = nrm / (2.0 * area);
+            let mut stack = vec![(*tri, 0)];
+            while let Some((t, l)) = stack.pop() {
+                if l < level {
+                    let m = [
+                        0.5 * (t[0] + t[1]),
+                        0.5 * (t[1] + t[2]),
+                        0.5 * (t[2] + t[0]),
+                    ];
+                    stack.push(([t[0], m[0], m[2]], l + 1));
+                    stack.push(([m[0], t[1], m[1]], l + 1));
+                    stack.push(([m[2], m[1], t[2]], l + 1));
+                    stack.push(([m[0], m[1], m[2]], l + 1));
+                    continue;
+                }
+                let x = (t[0] + t[1] + t[2]) / 3.0;
+                let a = area / 4f64.powi(level);
+                let to = light - x;
+                let d2 = to.length_squared();
+                let cos = n.dot(to) / d2.sqrt();
+                if cos <= 0.0 {
+                    continue;
+                }
+                let e = cos / d2 * ft_dielectric(cos, eta) * a;
+                let rd = model.rd_rgb(x.distance(g.p) / u);
+                for c in 0..3 {
+                    sum[c] += rd[c] / (u * u) * intensity[c] * e;
+                }
+            }
+        }
+        for c in 0..3 {
+            out[g.pixel as usize][c] += exit * sum[c];
+        }
+    }
+    out
+}
+
+#[test]
+fn agrees_with_brute_force_within_its_intervals() {
+    // 24 × 18 pixels, 2 samples each: about 130 lit pixels of the skin sphere.
+    let mut s = scene("sphere", 24, 18);
+    s.camera.pixel_samples = 2;
+    let settings = RenderSettings::default();
+    let frame = Frame::prepare(&s, settings.seed);
+    let reference = brute_force_sphere(&s, &frame);
+    let eps = 0.02;
+    let m = integrators::build("manylight", &MethodOptions::new().with("eps", eps)).unwrap();
+    let out = render(&s, m.as_ref(), &settings, &NoProgress).unwrap();
+    let se = out.std_error.as_ref().unwrap();
+    let triplets = &out
+        .layers
+        .iter()
+        .find(|l| l.name == "triplets")
+        .unwrap()
+        .pixels;
+    let t = StudentT::new(0.95).unwrap();
+    let (mut n, mut inside, mut rel_sum) = (0usize, 0usize, 0.0);
+    for i in 0..reference.len() {
+        let r = lum(reference[i]);
+        if r <= 0.0 {
+            continue;
+        }
+        let v = lum(out.subsurface[i]);
+        let j = triplets[i][0] as usize;
+        assert!(j >= 8, "pixel {i}: {j} triplets");
+        let delta = t.quantile(j) * lum(se[i]);
+        n += 1;
+        rel_sum += (v - r).abs() / r;
+        // 0.3 % of slack for the brute force's own quadrature error.
+        if (v - r).abs() <= delta + 3e-3 * r {
+            inside += 1;
+        }
+    }
+    let frac = inside as f64 / n as f64;
+    let mean_rel = rel_sum / n as f64;
+    eprintln!("{n} pixels, {frac:.3} inside ΔI, mean relative error {mean_rel:.4}");
+    assert!(n > 80, "{n} lit pixels");
+    // α = 95 %: at least 85 % of pixels inside (a binomial of 100+ pixels at p = 0.95 falls
+    // below 0.85 with probability < 1e-4), and the mean error well under ε.
+    assert!(frac >= 0.85, "{frac} of pixels inside their intervals");
+    assert!(mean_rel < eps, "mean relative error {mean_rel}");
+}
+
+#[test]
+fn caps_are_reported_and_hold() {
+    let s = scene("sphere", 12, 9);
+    let m = integrators::build(
+        "manylight",
+        &MethodOptions::new().with("eps", 0).with("max-triplets", 40),
+    )
+    .unwrap();
+    let out = render(&s, m.as_ref(), &RenderSettings::default(), &NoProgress).unwrap();
+    let stat = |n: &str| out.stats.iter().find(|s| s.name == n).unwrap().value;
+    let estimates = stat("pixel_estimates");
+    assert!(estimates > 20.0, "{estimates}");
+    // ε = 0 never converges: every lit estimate stops at the cap of 40 triplets.
+    assert_eq!(stat("pixels_converged"), 0.0);
+    assert_eq!(
+        stat("pixels_triplet_cap") + stat("pixels_zero") + stat("pixels_exact"),
+        estimates
+    );
+    assert!(stat("pixels_triplet_cap") >= 0.9 * estimates);
+    let layer = &out
+        .layers
+        .iter()
+        .find(|l| l.name == "triplets")
+        .unwrap()
+        .pixels;
+    assert!(layer.iter().all(|p| p[0] <= 40.0), "cap held");
+    assert!(stat("mean_triplets") <= 40.0 && stat("mean_triplets") >= 30.0);
+    assert!(
+        out.warnings.iter().any(|w| w.contains("triplet cap")),
+        "{:?}",
+        out.warnings
+    );
+}
+
+#[test]
+fn directional_dipole_and_bad_options_are_clear_errors() {
+    let s = scene("picnic", 16, 12);
+    let m = integrators::build("manylight", &MethodOptions::new()).unwrap();
+    let err = render(&s, m.as_ref(), &RenderSettings::default(), &NoProgress)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("`apple`") && err.contains("directional"),
+        "{err}"
+    );
+    for (k, v) in [
+        ("eps", "-1"),
+        ("alpha", "1"),
+        ("selection", "random"),
+        ("vpls", "0"),
+        ("max-triplets", "0"),
+    ] {
+        let e = integrators::build("manylight", &MethodOptions::new().with(k, v))
+            .err()
+            .unwrap_or_else(|| panic!("--{k} {v} accepted"))
+            .to_string();
+        assert!(e.contains(&format!("--{k}")), "{e}");
+    }
+}
+
+#[test]
+fn vpls_carry_the_lights_power() {
+    // Quad: Σ I_k = L·A (each VPL is L·A/N along the normal), every VPL on the quad.
+    let s = scene("backlit", 8, 6);
+    let Some(&Light::Quad {
+        corner,
+        edge_u,
+        edge_v,
+        radiance,
+    }) = s.lights.iter().find(|l| matches!(l, Light::Quad { .. }))
+    else {
+        panic!("backlit has a quad light")
+    };
+    let vpls = scene_vpls(&s, 100, 1, DVec3::ZERO, 1.0).unwrap();
+    let quad: Vec<_> = vpls.iter().filter(|v| v.normal.is_some()).collect();
+    assert_eq!(quad.len(), 100);
+    let area = edge_u.cross(edge_v).length();
+    let n = edge_u.cross(edge_v) / area;
+    for (c, l) in radiance.iter().enumerate() {
+        let sum: f64 = quad.iter().map(|v| v.intensity[c]).sum();
+        assert!((sum - l * area).abs() <= 1e-12 * l * area);
+    }
+    let (gu, gv) = (edge_u.length_squared(), edge_v.length_squared());
+    for v in &quad {
+        let d = v.position - corner;
+        assert!(d.dot(n).abs() < 1e-9);
+        let (a, b) = (d.dot(edge_u) / gu, d.dot(edge_v) / gv);
+        assert!((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b));
+        assert!((v.normal.unwrap() - n).length() < 1e-12);
+    }
+    // 100 = 10 × 10 strata: each cell of a 10 × 10 grid holds exactly one VPL.
+    let mut cells = [0u32; 100];
+    for v in &quad {
+        let d = v.position - corner;
+        let (a, b) = (d.dot(edge_u) / gu, d.dot(edge_v) / gv);
+        cells[((a * 10.0) as usize).min(9) + 10 * ((b * 10.0) as usize).min(9)] += 1;
+    }
+    assert!(cells.iter().all(|&c| c == 1));
+
+    // Environment (picnic): N distant VPLs, Σ I_k/D² = 4π L; their irradiance on an upward
+    // plane (open sky) is π L up to the sampling error: per VPL 4π L max(0, y) has standard
+    // deviation 1.29 π L, so over 4096 VPLs the relative error is 2 % per σ; 6 % is 3σ.
+    let p = scene("picnic", 8, 6);
+    let Some(&Light::Environment { radiance }) = p
+        .lights
+        .iter()
+        .find(|l| matches!(l, Light::Environment { .. }))
+    else {
+        panic!("picnic has an environment light")
+    };
+    let vpls = scene_vpls(&p, 4096, 3, DVec3::ZERO, 2.0).unwrap();
+    let far = DISTANT_FACTOR * 2.0;
+    let env: Vec<_> = vpls
+        .iter()
+        .filter(|v| (v.position.length() - far).abs() < 1e-6 * far)
+        .collect();
+    assert_eq!(env.len(), 4096);
+    let total: f64 = env.iter().map(|v| v.intensity[1]).sum::<f64>() / (far * far);
+    assert!((total - 4.0 * PI * radiance[1]).abs() < 1e-9 * total);
+    let e_up: f64 = env
+        .iter()
+        .map(|v| v.intensity[1] / (far * far) * (v.position.normalize().y).max(0.0))
+        .sum();
+    let rel = (e_up - PI * radiance[1]).abs() / (PI * radiance[1]);
+    assert!(rel < 0.06, "irradiance on an upward plane off by {rel}");
+    // The point light is one VPL of its intensity.
+    assert_eq!(vpls.len(), 4097);
+}
+
+#[test]
+fn every_radial_model_and_light_kind_of_picnic_renders() {
+    // Picnic with the apple's directional dipole swapped for the better dipole: standard
+    // dipole, PBD (a tabulated profile: its monotonicity check must pass) and better dipole,
+    // under a point and an environment light; every value finite and ≥ 0, every object lit.
+    let mut s = scene("picnic", 32, 24);
+    for m in &mut s.materials {
+        if let sss_scene::MaterialKind::Translucent(t) = &mut m.kind
+            && t.model == sss_bssrdf::ModelKind::DirectionalDipole
+        {
+            t.model = sss_bssrdf::ModelKind::BetterDipole;
+        }
+    }
+    let m = integrators::build(
+        "manylight",
+        &MethodOptions::new().with("eps", 0.1).with("vpls", 64),
+    )
+    .unwrap();
+    let out = render(&s, m.as_ref(), &RenderSettings::default(), &NoProgress).unwrap();
+    let stat = |n: &str| out.stats.iter().find(|s| s.name == n).unwrap().value;
+    assert_eq!(stat("vpls"), 65.0, "1 point + 64 environment VPLs");
+    let frame = Frame::prepare(&s, 1);
+    let mut lit = vec![false; s.objects.len()];
+    for g in &frame.gbuffer.samples {
+        let v = out.subsurface[g.pixel as usize];
+        assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "{v:?}");
+        if frame.shading_of(g.object).is_some() && v.iter().any(|x| *x > 0.0) {
+            lit[g.object as usize] = true;
+        }
+    }
+    for &o in &frame.visible {
+        assert!(
+            lit[o as usize],
+            "object {} unlit",
+            s.objects[o as usize].name
+        );
+    }
+    assert!(stat("pixels_converged") > 0.5 * stat("pixel_estimates"));
+}
