@@ -59,25 +59,63 @@ pub fn method_parser() -> PossibleValuesParser {
     PossibleValuesParser::new(METHODS.iter().map(|m| m.name))
 }
 
+/// The declarations of option `name` by the methods `users`, grouped by (help, default): one
+/// group when they agree; several when methods share a name with their own meaning (e.g.
+/// `--eps`, a solid-angle threshold for the trees and a relative error for `manylight`).
+fn variants(name: &str, users: &[&str]) -> Vec<(OptionSpec, Vec<&'static str>)> {
+    let mut out: Vec<(OptionSpec, Vec<&'static str>)> = Vec::new();
+    for m in METHODS.iter().filter(|m| users.contains(&m.name)) {
+        let Some(o) = m.options.iter().find(|o| o.name == name) else {
+            continue;
+        };
+        match out
+            .iter_mut()
+            .find(|(s, _)| s.help == o.help && s.default == o.default)
+        {
+            Some((_, ms)) => ms.push(m.name),
+            None => out.push((*o, vec![m.name])),
+        }
+    }
+    out
+}
+
 fn arg(spec: &OptionSpec, users: &[&str]) -> Arg {
-    let used_by = if users.len() == METHODS.len() {
-        String::new()
-    } else {
-        format!(" ({})", users.join(", "))
+    let used_by = |users: &[&str]| {
+        if users.len() == METHODS.len() {
+            String::new()
+        } else {
+            format!(" ({})", users.join(", "))
+        }
     };
+    let groups = variants(spec.name, users);
     let arg = Arg::new(spec.name).long(spec.name);
     match spec.kind {
-        OptionKind::Flag => arg
-            .action(ArgAction::SetTrue)
-            .help(format!("{}{used_by}", spec.help)),
-        OptionKind::Value => arg
-            .action(ArgAction::Set)
-            .value_name(spec.value_name)
-            .allow_hyphen_values(true)
-            .help(format!(
-                "{}{used_by} [default: {}]",
-                spec.help, spec.default
-            )),
+        OptionKind::Flag => {
+            arg.action(ArgAction::SetTrue)
+                .help(format!("{}{}", spec.help, used_by(users)))
+        }
+        OptionKind::Value => {
+            let help = if groups.len() <= 1 {
+                format!(
+                    "{}{} [default: {}]",
+                    spec.help,
+                    used_by(users),
+                    spec.default
+                )
+            } else {
+                groups
+                    .iter()
+                    .map(|(o, ms)| {
+                        format!("{}: {} [default: {}]", ms.join(", "), o.help, o.default)
+                    })
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            };
+            arg.action(ArgAction::Set)
+                .value_name(spec.value_name)
+                .allow_hyphen_values(true)
+                .help(help)
+        }
     }
 }
 
@@ -127,7 +165,9 @@ impl<S: FlagSet> clap::Args for MethodFlags<S> {
 mod tests {
     use super::*;
 
-    /// Options shared by several methods must mean the same thing in each.
+    /// Options shared by several methods must be the same kind of flag (a switch in one and a
+    /// value in another could not share `--name`); their help and default may differ, and
+    /// the help then says which applies to which method.
     #[test]
     fn shared_options_agree_between_methods() {
         for m in METHODS {
@@ -135,12 +175,35 @@ mod tests {
                 for other in METHODS {
                     if let Some(o) = other.options.iter().find(|o| o.name == spec.name) {
                         assert_eq!(
-                            o, spec,
+                            (o.kind, o.value_name),
+                            (spec.kind, spec.value_name),
                             "--{} differs between {} and {}",
-                            spec.name, m.name, other.name
+                            spec.name,
+                            m.name,
+                            other.name
                         );
                     }
                 }
+            }
+        }
+        // --eps means two things: the help names both, with both defaults.
+        let users: Vec<&str> = METHODS
+            .iter()
+            .filter(|m| m.options.iter().any(|o| o.name == "eps"))
+            .map(|m| m.name)
+            .collect();
+        let groups = variants("eps", &users);
+        if groups.len() > 1 {
+            let spec = groups[0].0;
+            let help = arg(&spec, &users)
+                .get_help()
+                .map(|h| h.to_string())
+                .unwrap_or_default();
+            for (o, ms) in &groups {
+                assert!(
+                    help.contains(o.default) && ms.iter().all(|m| help.contains(m)),
+                    "{help}"
+                );
             }
         }
     }
