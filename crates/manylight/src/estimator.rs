@@ -48,6 +48,9 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
+/// cos θ_i at or below this is a grazing, in-plane light (see the sample loop): no light.
+pub const GRAZING_COS: f64 = 1e-9;
+
 use glam::DVec3;
 
 use crate::Error;
@@ -539,7 +542,11 @@ impl<'a> Estimator<'a> {
             let dir = to_light / d;
             let cos_i = ni.dot(dir);
             let cos_y = vpl.emission_cos(-dir);
-            if cos_i <= 0.0 || cos_y <= 0.0 {
+            // A light in the plane of the irradiance point's triangle (to rounding: a VPL on a
+            // vertex of the surface lights the triangles around it edge-on) contributes
+            // nothing: cos θ_i below GRAZING_COS counts as 0 (its true weight, cos θ_i ·
+            // F_t(cos θ_i) ~ cos², is below 10⁻¹⁸ there).
+            if cos_i <= GRAZING_COS || cos_y <= 0.0 {
                 continue;
             }
             if d2 < 1.0 / g_max {

@@ -96,7 +96,10 @@ fn disk_averaged_exact_agrees_with_pathtrace_per_pixel() {
     let translucent = exact.translucent_pixels();
     let pt = render(
         &scene,
-        &PathTrace { spp: 1024 },
+        &PathTrace {
+            spp: 1024,
+            ..PathTrace::default()
+        },
         &RenderSettings {
             seed: 11,
             ..settings.clone()
