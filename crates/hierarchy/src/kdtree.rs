@@ -230,8 +230,7 @@ mod tests {
         assert!(seen.iter().all(|&s| s));
         for n in &t.nodes {
             for &i in t.items(n) {
-                for k in 0..D {
-                    let x = points[i as usize][k];
+                for (k, &x) in points[i as usize].iter().enumerate() {
                     assert!(n.lo[k] <= x && x <= n.hi[k]);
                 }
             }
