@@ -174,6 +174,12 @@ impl TranslucentShading {
                 return [0, 1, 2].map(|c| rd[c] * (1.0 + t[c]));
             }
         }
+        // A disk whose nearest point is so far that R_d has underflowed to 0 there averages to
+        // 0 (the profiles are non-increasing in r): one evaluation instead of a quadrature,
+        // which matters for huge disks (coarse samples on huge objects).
+        if r > a && self.rd_scene(r - a).iter().all(|&v| v == 0.0) {
+            return [0.0; 3];
+        }
         self.disk_average(r, a)
     }
 
