@@ -177,7 +177,14 @@ impl TranslucentShading {
         // A disk whose nearest point is so far that R_d has underflowed to 0 there averages to
         // 0 (the profiles are non-increasing in r): one evaluation instead of a quadrature,
         // which matters for huge disks (coarse samples on huge objects).
-        if r > a && self.rd_scene(r - a).iter().all(|&v| v == 0.0) {
+        // (Tested in mm: the conversion to scene units could turn 0 into 0·∞ for absurd units.)
+        if r > a
+            && self
+                .bssrdf()
+                .rd_rgb((r - a) / self.units_per_mm)
+                .iter()
+                .all(|&v| v == 0.0)
+        {
             return [0.0; 3];
         }
         self.disk_average(r, a)
