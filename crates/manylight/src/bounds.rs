@@ -10,11 +10,16 @@
 //! * **R_d^u** = max_c R_d,c(r_min): ρ is a weighted mean of the channels, each channel is
 //!   non-increasing in r (checked by [`RadialProfile::new`]), and r ≥ r_min, the minimum
 //!   distance between the IC and SC boxes.
-//! * **G^u** = min(1/d_min², G_max): cosines are ≤ 1, d ≥ d_min (LC box to IC box). The clamp
-//!   G_max is the same constant as in the estimator (VPLs on or next to the surface make
-//!   1/d_min² unbounded; MDLC clamps d² at (0.05 × scene half-diagonal)², wave2 F2.3).
-//! * **F_t^u** = F_t(1), the normal-incidence value (F_t is non-decreasing in cos θ, checked
-//!   by [`Transmittance::new`]).
+//! * **G^u** = cos_i^u · cos_y^u · min(1/d_min², G_max): d ≥ d_min (LC box to IC box), and the
+//!   cosines are bounded by the clusters' normal cones ([`crate::cone::cos_upper`], MDLC's
+//!   cosine bound; 1 for a cluster of point lights). The clamp G_max is the same constant as in
+//!   the estimator (VPLs on or next to the surface make 1/d_min² unbounded; MDLC clamps d² at
+//!   (0.05 × scene half-diagonal)², wave2 F2.3). The paper's bound has no cosines; without
+//!   them every triangle facing away from the light (a slab's underside, a sphere's night
+//!   side) keeps a bound as large as a lit one, and the refinement splits it although every
+//!   sample is 0.
+//! * **F_t^u** = F_t(cos_i^u) (F_t is non-decreasing in cos θ, checked by
+//!   [`Transmittance::new`]; F_t(1), the normal-incidence value, without a cone).
 //! * **e_j** = A_j W_j I_j R_d^u G^u F_t^u / (2√n_j): every sample lies in [0, M_j] with
 //!   M_j = A_j W_j I_j R_d^u G^u F_t^u, so by Popoviciu's inequality (Popoviciu 1935: a
 //!   variable confined to [a, b] has variance ≤ (b − a)²/4) its standard deviation is ≤ M_j/2
@@ -24,6 +29,8 @@
 //! bounding spheres for the selection (Eq. 11–13, as the paper), every distance clamped at ≥ 0.
 
 use crate::aabb::{Aabb, Sphere};
+use crate::cone::{NormalCone, cos_upper};
+use crate::estimator::GRAZING_COS;
 use crate::profile::{RadialProfile, Transmittance};
 
 /// The clamped inverse square distance min(1/d², G_max) = 1/max(d², 1/G_max), used by the
@@ -45,9 +52,23 @@ pub fn g_upper(lc: &Aabb, ic: &Aabb, g_max: f64) -> f64 {
     inv_sq_clamped(lc.min_distance_sq(ic), g_max)
 }
 
-/// F_t^u: the normal-incidence transmittance.
-pub fn ft_upper(ft: &Transmittance) -> f64 {
-    ft.max()
+/// cos_i^u: the largest cosine between a normal of the irradiance cluster (box `ic`, normals
+/// in `ic_cone`) and the direction from its points to the light cluster's box `lc`; 0 when it
+/// is at most [`GRAZING_COS`] (the estimator counts such lights as none), 1 without a cone.
+pub fn cos_i_upper(ic_cone: Option<&NormalCone>, ic: &Aabb, lc: &Aabb) -> f64 {
+    let c = ic_cone.map_or(1.0, |k| cos_upper(k, ic, lc));
+    if c <= GRAZING_COS { 0.0 } else { c }
+}
+
+/// cos_y^u: the largest emission cosine of an oriented light cluster (normals in `lc_cone`)
+/// towards the irradiance cluster's box; 1 for a cluster holding a point light (`None`).
+pub fn cos_y_upper(lc_cone: Option<&NormalCone>, lc: &Aabb, ic: &Aabb) -> f64 {
+    lc_cone.map_or(1.0, |k| cos_upper(k, lc, ic))
+}
+
+/// F_t^u: F_t at the largest cosine `cos_i_u` (the normal-incidence value when that is 1).
+pub fn ft_upper(ft: &Transmittance, cos_i_u: f64) -> f64 {
+    ft.eval(cos_i_u).min(ft.max())
 }
 
 /// M_j = A_j W_j I_j R_d^u G^u F_t^u: the largest value one sample of the triplet can take

@@ -19,7 +19,10 @@
 //! paper's form is √2 wider than the textbook stratified interval ([`Interval::StandardError`]).
 //! The Student-t quantile uses **ν = N − J = J degrees of freedom**: each stratum's variance
 //! estimate from two samples has one degree of freedom, and the pooled estimate has their sum
-//! (Cochran, *Sampling Techniques*, 3rd ed., §5.4; the paper leaves ν unstated).
+//! (Cochran, *Sampling Techniques*, 3rd ed., §5.4; the paper leaves ν unstated). A triplet
+//! whose bound M_j is 0 (its clusters face away from each other, see [`crate::bounds`]) is an
+//! exact 0, not a sampled stratum: it is not sampled, not refined, and not counted in J for ν
+//! or for `min_triplets`.
 //!
 //! # Refinement
 //!
@@ -114,15 +117,17 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// ε = 2 %, BSSRDF-aware selection, the given G clamp, 100 000 triplets, 32 768 splits
-    /// (about 13 MB of arena), at least 8 triplets, the standard-error interval.
+    /// ε = 2 %, BSSRDF-aware selection, the given G clamp, 200 000 triplets and 200 000 splits
+    /// per pixel (at most about 110 MB, see [`Settings::peak_pixel_bytes`]; the pixels 2
+    /// diffusion lengths deep in the shadow of the `slab` scene need 144 000 of each at
+    /// ε = 2 %), at least 8 triplets, the standard-error interval.
     pub fn new(g_max: f64) -> Settings {
         Settings {
             epsilon: 0.02,
             selection: Selection::BssrdfAware,
             g_max,
-            max_triplets: 100_000,
-            max_splits: 32_768,
+            max_triplets: 200_000,
+            max_splits: 200_000,
             min_triplets: 8,
             interval: Interval::StandardError,
         }
@@ -136,6 +141,17 @@ impl Settings {
         } else {
             f64::MAX
         }
+    }
+
+    /// The most memory one pixel's estimate can take at the caps: the triplet list (each
+    /// refinement retires one triplet and adds two, so up to 2 · `max_triplets` entries), its
+    /// priority queue, and the split arena (two triangles per split plus the index of split
+    /// mesh triangles). Allocated as needed; a thread reuses it from pixel to pixel.
+    pub fn peak_pixel_bytes(&self) -> u64 {
+        let triplets = 2 * self.max_triplets as u64;
+        let splits = self.max_splits as u64;
+        triplets * (size_of::<Triplet>() + size_of::<Item>()) as u64
+            + splits * (2 * size_of::<crate::irradiance_cluster::SplitNode>() + 16) as u64
     }
 
     fn validate(&self) -> Result<(), Error> {
@@ -384,21 +400,23 @@ impl<'a> Estimator<'a> {
         );
         sums.add(&root, 1.0);
         triplets.push(root);
-        heap.push(Item { e: root.e, idx: 0 });
+        if root.m > 0.0 {
+            heap.push(Item { e: root.e, idx: 0 });
+        }
 
         let eps = self.settings.epsilon;
         let status = loop {
             if sums.bounded == 0 {
                 break Status::Exact;
             }
-            if sums.live >= self.settings.min_triplets {
+            if sums.bounded >= self.settings.min_triplets {
                 if sums.nonzero == 0 {
                     break Status::Zero;
                 }
-                if sums.value > 0.0 && self.delta(sums.live, sums.s2) < eps * sums.value {
+                if sums.value > 0.0 && self.delta(sums.bounded, sums.s2) < eps * sums.value {
                     // Confirm on exact sums (the running ones drift by rounding).
                     sums = exact_sums(&triplets);
-                    if self.delta(sums.live, sums.s2) < eps * sums.value {
+                    if self.delta(sums.bounded, sums.s2) < eps * sums.value {
                         break Status::Converged;
                     }
                 }
@@ -419,19 +437,25 @@ impl<'a> Estimator<'a> {
             for (l, i, s) in children {
                 let c = self.eval(l, i, s, shading, refs, visibility, &mut rng, &mut counters);
                 sums.add(&c, 1.0);
-                heap.push(Item {
-                    e: c.e,
-                    idx: triplets.len() as u32,
-                });
+                // A triplet with bound 0 is exactly 0: nothing to refine.
+                if c.m > 0.0 {
+                    heap.push(Item {
+                        e: c.e,
+                        idx: triplets.len() as u32,
+                    });
+                }
                 triplets.push(c);
             }
         };
         let sums = exact_sums(&triplets);
-        let zero_variance = triplets.iter().filter(|t| t.live && t.s2 == 0.0).count();
+        let zero_variance = triplets
+            .iter()
+            .filter(|t| t.live && t.m > 0.0 && t.s2 == 0.0)
+            .count();
         PixelEstimate {
             rgb: sums.rgb,
             value: sums.value,
-            delta: self.delta(sums.live, sums.s2),
+            delta: self.delta(sums.bounded, sums.s2),
             triplets: sums.live,
             splits: refs.splits(),
             split_cap_hits: refs.cap_hits(),
@@ -516,8 +540,16 @@ impl<'a> Estimator<'a> {
             return t;
         }
         let rd_u = bounds::rd_upper(self.profile, &ibox, &sn.bbox);
-        let g_u = bounds::g_upper(&ln.bbox, &ibox, g_max);
-        t.m = bounds::sample_bound(a, w, il, rd_u, g_u, bounds::ft_upper(self.ft));
+        let cone_i = refs.cone(self.surface, i);
+        let cos_i_u = bounds::cos_i_upper(cone_i.as_ref(), &ibox, &ln.bbox);
+        let cos_y_u = bounds::cos_y_upper(ln.cone.as_ref(), &ln.bbox, &ibox);
+        let g_u = cos_i_u * cos_y_u * bounds::g_upper(&ln.bbox, &ibox, g_max);
+        t.m = bounds::sample_bound(a, w, il, rd_u, g_u, bounds::ft_upper(self.ft, cos_i_u));
+        if t.m <= 0.0 {
+            // Every sample is 0 (the cluster faces away from every light of the cluster, or
+            // the lights away from it): an exact 0, never refined.
+            return t;
+        }
         t.e = bounds::error_bound(t.m, SAMPLES_PER_TRIPLET);
         let scale = a * w * il;
         let mut f = [0.0f64; 2];

@@ -9,6 +9,8 @@ use glam::DVec3;
 
 use crate::Error;
 use crate::aabb::Aabb;
+use crate::binary_tree::{descend, median_split};
+use crate::cone::NormalCone;
 
 /// A triangle with its area and unit geometric normal (from the winding: counter-clockwise seen
 /// from the side the normal points to; the estimator treats that side as outside).
@@ -48,6 +50,14 @@ impl Triangle {
         b0 * self.v[0] + b1 * self.v[1] + (1.0 - b0 - b1) * self.v[2]
     }
 
+    /// The cone of its one normal (half-angle 0), `None` for a degenerate triangle.
+    pub fn cone(&self) -> Option<NormalCone> {
+        (self.normal != DVec3::ZERO).then_some(NormalCone {
+            axis: self.normal,
+            half_angle: 0.0,
+        })
+    }
+
     /// The two halves cut at the midpoint of the longest edge, both with the parent's winding
     /// and each with exactly half its area.
     pub fn halve(&self) -> [Triangle; 2] {
@@ -84,6 +94,8 @@ pub struct IcNode {
     pub children: Option<[u32; 2]>,
     /// The triangle of a leaf (index into [`IrradianceTree::triangles`]).
     pub triangle: u32,
+    /// A cone holding the normals of the triangles below (`None` when all are degenerate).
+    pub cone: Option<NormalCone>,
 }
 
 /// A BVH over a mesh's triangles, one triangle per leaf, built top-down by median split of the
@@ -142,64 +154,29 @@ impl IrradianceTree {
             .iter()
             .map(|t| (t.v[0] + t.v[1] + t.v[2]) / 3.0)
             .collect();
-        let mut order: Vec<u32> = (0..tris.len() as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * tris.len() - 1);
-        let blank = IcNode {
-            bbox: Aabb::EMPTY,
-            area: 0.0,
-            children: None,
-            triangle: 0,
-        };
-        nodes.push(blank);
-        let mut stack = vec![(0u32, 0usize, tris.len())];
-        let mut post = Vec::new();
-        while let Some((node, lo, hi)) = stack.pop() {
-            let range = &mut order[lo..hi];
-            if range.len() == 1 {
-                let t = &tris[range[0] as usize];
-                nodes[node as usize] = IcNode {
+        let nodes = median_split(
+            &centroids,
+            |k| {
+                let t = &tris[k as usize];
+                IcNode {
                     bbox: t.bbox(),
                     area: t.area,
                     children: None,
-                    triangle: range[0],
-                };
-                continue;
-            }
-            let e = range
-                .iter()
-                .fold(Aabb::EMPTY, |b, &k| b.grow(centroids[k as usize]))
-                .extent();
-            let axis = if e.x >= e.y && e.x >= e.z {
-                0
-            } else if e.y >= e.z {
-                1
-            } else {
-                2
-            };
-            range.sort_unstable_by(|&p, &q| {
-                centroids[p as usize][axis]
-                    .total_cmp(&centroids[q as usize][axis])
-                    .then(p.cmp(&q))
-            });
-            let mid = lo + range.len() / 2;
-            let (l, r) = (nodes.len() as u32, nodes.len() as u32 + 1);
-            nodes.push(blank);
-            nodes.push(blank);
-            nodes[node as usize].children = Some([l, r]);
-            post.push(node);
-            stack.push((l, lo, mid));
-            stack.push((r, mid, hi));
-        }
-        for &id in post.iter().rev() {
-            let [l, r] = nodes[id as usize].children.expect("inner node");
-            let (a, b) = (nodes[l as usize], nodes[r as usize]);
-            nodes[id as usize] = IcNode {
+                    triangle: k,
+                    cone: t.cone(),
+                }
+            },
+            |a, b, children| IcNode {
                 bbox: a.bbox.union(b.bbox),
                 area: a.area + b.area,
-                children: Some([l, r]),
+                children: Some(children),
                 triangle: a.triangle,
-            };
-        }
+                cone: match (a.cone, b.cone) {
+                    (Some(p), Some(q)) => Some(p.union(q)),
+                    (p, q) => p.or(q),
+                },
+            },
+        );
         Ok(IrradianceTree {
             triangles: tris,
             nodes,
@@ -312,6 +289,14 @@ impl Refinements {
         }
     }
 
+    /// The normal cone of a cluster (`None`: no non-degenerate triangle).
+    pub fn cone(&self, tree: &IrradianceTree, id: IcId) -> Option<NormalCone> {
+        match id {
+            IcId::Base(n) => tree.nodes[n as usize].cone,
+            IcId::Split(k) => self.nodes[k as usize].triangle.cone(),
+        }
+    }
+
     /// True if the cluster is one triangle (a BVH leaf or an arena triangle).
     pub fn is_single_triangle(&self, tree: &IrradianceTree, id: IcId) -> bool {
         match id {
@@ -388,27 +373,15 @@ impl Refinements {
     pub fn sample(&self, tree: &IrradianceTree, id: IcId, u: [f64; 3]) -> (DVec3, DVec3) {
         let tri = match id {
             IcId::Split(k) => &self.nodes[k as usize].triangle,
-            IcId::Base(mut n) => {
-                let mut u0 = u[0];
-                loop {
-                    let node = &tree.nodes[n as usize];
-                    let Some([a, b]) = node.children else {
-                        break &tree.triangles[node.triangle as usize];
-                    };
-                    let (wa, wb) = (tree.nodes[a as usize].area, tree.nodes[b as usize].area);
-                    let pa = if wa + wb > 0.0 { wa / (wa + wb) } else { 1.0 };
-                    if u0 < pa || wb <= 0.0 {
-                        u0 = if pa > 0.0 {
-                            (u0 / pa).min(1.0 - f64::EPSILON)
-                        } else {
-                            0.0
-                        };
-                        n = a;
-                    } else {
-                        u0 = ((u0 - pa) / (1.0 - pa)).clamp(0.0, 1.0 - f64::EPSILON);
-                        n = b;
-                    }
-                }
+            IcId::Base(n) => {
+                let nodes = &tree.nodes;
+                let (leaf, _) = descend(
+                    n,
+                    u[0],
+                    |k| nodes[k as usize].children,
+                    |k| nodes[k as usize].area,
+                );
+                &tree.triangles[nodes[leaf as usize].triangle as usize]
             }
         };
         (tri.sample(u[1], u[2]), tri.normal)

@@ -71,7 +71,9 @@
 //! ```
 
 pub mod aabb;
+mod binary_tree;
 pub mod bounds;
+pub mod cone;
 pub mod confidence;
 pub mod estimator;
 pub mod irradiance_cluster;

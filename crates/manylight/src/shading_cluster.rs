@@ -6,6 +6,7 @@ use glam::DVec3;
 
 use crate::Error;
 use crate::aabb::Aabb;
+use crate::binary_tree::{descend, median_split};
 
 /// A shading point x_o with its weight w(x_o) = W(x_o) F_t(x_o) / (π p(x_o) |S|) (Eq. 2): the
 /// caller folds the pixel filter, the exit Fresnel factor and the sample count into `weight`,
@@ -63,63 +64,22 @@ impl ShadingTree {
                 )));
             }
         }
-        let blank = ShadingNode {
-            bbox: Aabb::EMPTY,
-            weight: 0.0,
-            children: None,
-            point: 0,
-        };
-        let mut order: Vec<u32> = (0..points.len() as u32).collect();
-        let mut nodes = vec![blank];
-        let mut stack = vec![(0u32, 0usize, points.len())];
-        let mut post = Vec::new();
-        while let Some((node, lo, hi)) = stack.pop() {
-            let range = &mut order[lo..hi];
-            if range.len() == 1 {
-                let p = &points[range[0] as usize];
-                nodes[node as usize] = ShadingNode {
-                    bbox: Aabb::point(p.position),
-                    weight: p.weight,
-                    children: None,
-                    point: range[0],
-                };
-                continue;
-            }
-            let e = range
-                .iter()
-                .fold(Aabb::EMPTY, |b, &k| b.grow(points[k as usize].position))
-                .extent();
-            let axis = if e.x >= e.y && e.x >= e.z {
-                0
-            } else if e.y >= e.z {
-                1
-            } else {
-                2
-            };
-            range.sort_unstable_by(|&p, &q| {
-                points[p as usize].position[axis]
-                    .total_cmp(&points[q as usize].position[axis])
-                    .then(p.cmp(&q))
-            });
-            let mid = lo + range.len() / 2;
-            let (l, r) = (nodes.len() as u32, nodes.len() as u32 + 1);
-            nodes.push(blank);
-            nodes.push(blank);
-            nodes[node as usize].children = Some([l, r]);
-            post.push(node);
-            stack.push((l, lo, mid));
-            stack.push((r, mid, hi));
-        }
-        for &id in post.iter().rev() {
-            let [l, r] = nodes[id as usize].children.expect("inner node");
-            let (a, b) = (nodes[l as usize], nodes[r as usize]);
-            nodes[id as usize] = ShadingNode {
+        let positions: Vec<DVec3> = points.iter().map(|p| p.position).collect();
+        let nodes = median_split(
+            &positions,
+            |k| ShadingNode {
+                bbox: Aabb::point(points[k as usize].position),
+                weight: points[k as usize].weight,
+                children: None,
+                point: k,
+            },
+            |a, b, children| ShadingNode {
                 bbox: a.bbox.union(b.bbox),
                 weight: a.weight + b.weight,
-                children: Some([l, r]),
+                children: Some(children),
                 point: a.point,
-            };
-        }
+            },
+        );
         Ok(ShadingTree { points, nodes })
     }
 
@@ -141,25 +101,14 @@ impl ShadingTree {
 
     /// Samples a point below `id` with probability `weight / node.weight` (p_S of Eq. 5) from
     /// one uniform in [0, 1). Returns the point index.
-    pub fn sample(&self, mut id: u32, mut u: f64) -> u32 {
-        loop {
-            let n = &self.nodes[id as usize];
-            let Some([a, b]) = n.children else {
-                return n.point;
-            };
-            let (wa, wb) = (self.nodes[a as usize].weight, self.nodes[b as usize].weight);
-            let pa = if wa + wb > 0.0 { wa / (wa + wb) } else { 1.0 };
-            if u < pa || wb <= 0.0 {
-                u = if pa > 0.0 {
-                    (u / pa).min(1.0 - f64::EPSILON)
-                } else {
-                    0.0
-                };
-                id = a;
-            } else {
-                u = ((u - pa) / (1.0 - pa)).clamp(0.0, 1.0 - f64::EPSILON);
-                id = b;
-            }
-        }
+    pub fn sample(&self, id: u32, u: f64) -> u32 {
+        let nodes = &self.nodes;
+        let (leaf, _) = descend(
+            id,
+            u,
+            |n| nodes[n as usize].children,
+            |n| nodes[n as usize].weight,
+        );
+        nodes[leaf as usize].point
     }
 }

@@ -6,6 +6,8 @@ use glam::DVec3;
 
 use crate::Error;
 use crate::aabb::Aabb;
+use crate::binary_tree::{descend, median_split};
+pub use crate::cone::NormalCone;
 use crate::profile::luminance;
 
 /// What kind of emitter a VPL is.
@@ -91,55 +93,6 @@ impl Vpl {
     }
 }
 
-/// A cone of directions: every normal in the cluster is within `half_angle` of `axis`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NormalCone {
-    /// Unit axis.
-    pub axis: DVec3,
-    /// Half-angle in radians, in [0, π] (π: any direction).
-    pub half_angle: f64,
-}
-
-impl NormalCone {
-    /// The smallest cone around both (the standard merge of two bounding cones: the merged
-    /// half-angle is (φ + θ₁ + θ₂)/2 with φ the angle between the axes, the axis rotated from
-    /// `self.axis` towards `o.axis`; Walter et al. 2006 keep such cones per node).
-    pub fn union(self, o: NormalCone) -> NormalCone {
-        let phi = angle_between(self.axis, o.axis);
-        if phi + o.half_angle <= self.half_angle {
-            return self;
-        }
-        if phi + self.half_angle <= o.half_angle {
-            return o;
-        }
-        let theta = 0.5 * (phi + self.half_angle + o.half_angle);
-        let perp = o.axis - self.axis * self.axis.dot(o.axis);
-        if theta >= std::f64::consts::PI || perp.length_squared() < 1e-24 {
-            return NormalCone {
-                axis: self.axis,
-                half_angle: std::f64::consts::PI,
-            };
-        }
-        let rot = theta - self.half_angle;
-        let axis = (self.axis * rot.cos() + perp.normalize() * rot.sin()).normalize();
-        NormalCone {
-            axis,
-            half_angle: theta,
-        }
-    }
-
-    /// True if unit direction `d` lies in the cone (with a 1e-9 rad tolerance).
-    pub fn contains(&self, d: DVec3) -> bool {
-        angle_between(self.axis, d) <= self.half_angle + 1e-9
-    }
-}
-
-/// The angle between two unit vectors as atan2(‖a × b‖, a · b), accurate near 0 and π (unlike
-/// acos of the dot product, which loses half the digits there).
-fn angle_between(a: DVec3, b: DVec3) -> f64 {
-    a.cross(b).length().atan2(a.dot(b))
-}
-
 /// A node of the [`LightTree`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightNode {
@@ -184,9 +137,40 @@ impl LightTree {
         for (k, v) in vpls.iter().enumerate() {
             v.validate(k)?;
         }
-        let mut order: Vec<u32> = (0..vpls.len() as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * vpls.len() - 1);
-        build(&vpls, &mut order, &mut nodes);
+        let positions: Vec<DVec3> = vpls.iter().map(|v| v.position).collect();
+        let leaf = |k: u32| {
+            let v = &vpls[k as usize];
+            LightNode {
+                bbox: Aabb::point(v.position),
+                intensity: v.scalar_intensity(),
+                representative: k,
+                cone: v.normal.map(|axis| NormalCone {
+                    axis,
+                    half_angle: 0.0,
+                }),
+                children: None,
+                vpl: k,
+            }
+        };
+        let inner = |a: &LightNode, b: &LightNode, children: [u32; 2]| {
+            let representative = if b.intensity > a.intensity {
+                b.representative
+            } else {
+                a.representative
+            };
+            LightNode {
+                bbox: a.bbox.union(b.bbox),
+                intensity: a.intensity + b.intensity,
+                representative,
+                cone: match (a.cone, b.cone) {
+                    (Some(x), Some(y)) => Some(x.union(y)),
+                    _ => None,
+                },
+                children: Some(children),
+                vpl: representative,
+            }
+        };
+        let nodes = median_split(&positions, leaf, inner);
         Ok(LightTree { vpls, nodes })
     }
 
@@ -215,139 +199,15 @@ impl LightTree {
     /// (p_L of Eq. 5) by descending in proportion to the children's intensities, from one
     /// uniform `u` in [0, 1). Returns the VPL index and its probability. A node of zero
     /// intensity returns its leftmost VPL with probability 0.
-    pub fn sample(&self, mut id: u32, mut u: f64) -> (u32, f64) {
-        let mut p = 1.0;
-        loop {
-            let n = &self.nodes[id as usize];
-            let Some([a, b]) = n.children else {
-                return (n.vpl, if n.intensity > 0.0 { p } else { 0.0 });
-            };
-            let (wa, wb) = (
-                self.nodes[a as usize].intensity,
-                self.nodes[b as usize].intensity,
-            );
-            let w = wa + wb;
-            if w <= 0.0 {
-                id = a;
-                p = 0.0;
-                continue;
-            }
-            let pa = wa / w;
-            if u < pa || wb <= 0.0 {
-                p *= pa;
-                u = if pa > 0.0 {
-                    (u / pa).min(1.0 - f64::EPSILON)
-                } else {
-                    0.0
-                };
-                id = a;
-            } else {
-                let pb = wb / w;
-                p *= pb;
-                u = ((u - pa) / pb).clamp(0.0, 1.0 - f64::EPSILON);
-                id = b;
-            }
-        }
-    }
-}
-
-/// Builds the subtree over `idx` and returns its node id. Iterative over an explicit stack to
-/// keep deep trees off the call stack: nodes are allocated first and filled bottom-up.
-fn build(vpls: &[Vpl], idx: &mut [u32], nodes: &mut Vec<LightNode>) {
-    // (node id, range start, range end)
-    struct Job {
-        node: u32,
-        lo: usize,
-        hi: usize,
-    }
-    let blank = LightNode {
-        bbox: Aabb::EMPTY,
-        intensity: 0.0,
-        representative: 0,
-        cone: None,
-        children: None,
-        vpl: 0,
-    };
-    nodes.push(blank);
-    let mut stack = vec![Job {
-        node: 0,
-        lo: 0,
-        hi: idx.len(),
-    }];
-    let mut post = Vec::new();
-    while let Some(j) = stack.pop() {
-        let range = &mut idx[j.lo..j.hi];
-        if range.len() == 1 {
-            let v = &vpls[range[0] as usize];
-            nodes[j.node as usize] = LightNode {
-                bbox: Aabb::point(v.position),
-                intensity: v.scalar_intensity(),
-                representative: range[0],
-                cone: v.normal.map(|axis| NormalCone {
-                    axis,
-                    half_angle: 0.0,
-                }),
-                children: None,
-                vpl: range[0],
-            };
-            continue;
-        }
-        let b = range
-            .iter()
-            .fold(Aabb::EMPTY, |b, &k| b.grow(vpls[k as usize].position));
-        let e = b.extent();
-        let axis = if e.x >= e.y && e.x >= e.z {
-            0
-        } else if e.y >= e.z {
-            1
-        } else {
-            2
-        };
-        // Sort by the axis coordinate, ties by index, so the tree is a function of the input.
-        range.sort_unstable_by(|&p, &q| {
-            let (a, c) = (
-                vpls[p as usize].position[axis],
-                vpls[q as usize].position[axis],
-            );
-            a.total_cmp(&c).then(p.cmp(&q))
-        });
-        let mid = j.lo + range.len() / 2;
-        let (l, r) = (nodes.len() as u32, nodes.len() as u32 + 1);
-        nodes.push(blank);
-        nodes.push(blank);
-        nodes[j.node as usize].children = Some([l, r]);
-        post.push(j.node);
-        stack.push(Job {
-            node: l,
-            lo: j.lo,
-            hi: mid,
-        });
-        stack.push(Job {
-            node: r,
-            lo: mid,
-            hi: j.hi,
-        });
-    }
-    // Children always have larger ids than their parent: fill parents in reverse order.
-    for &id in post.iter().rev() {
-        let [l, r] = nodes[id as usize].children.expect("inner node");
-        let (a, b) = (nodes[l as usize], nodes[r as usize]);
-        let cone = match (a.cone, b.cone) {
-            (Some(x), Some(y)) => Some(x.union(y)),
-            _ => None,
-        };
-        let representative = if b.intensity > a.intensity {
-            b.representative
-        } else {
-            a.representative
-        };
-        nodes[id as usize] = LightNode {
-            bbox: a.bbox.union(b.bbox),
-            intensity: a.intensity + b.intensity,
-            representative,
-            cone,
-            children: Some([l, r]),
-            vpl: representative,
-        };
+    pub fn sample(&self, id: u32, u: f64) -> (u32, f64) {
+        let nodes = &self.nodes;
+        let (leaf, p) = descend(
+            id,
+            u,
+            |n| nodes[n as usize].children,
+            |n| nodes[n as usize].intensity,
+        );
+        let n = &nodes[leaf as usize];
+        (n.vpl, if n.intensity > 0.0 { p } else { 0.0 })
     }
 }

@@ -7,16 +7,8 @@ use glam::DVec3;
 use sss_manylight::bounds::*;
 use sss_manylight::*;
 
-struct U(u64);
-impl U {
-    fn f(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        (sss_util::splitmix64_mix(self.0) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn v(&mut self) -> DVec3 {
-        DVec3::new(self.f(), self.f(), self.f())
-    }
-}
+mod common;
+use common::U;
 
 /// A dipole-like profile: (1 + σr) e^{−σr} / (r² + z²)^{3/2}-shaped, strictly decreasing.
 fn rd(r: f64) -> [f64; 3] {
@@ -80,7 +72,7 @@ fn rd_g_ft_and_error_bounds_are_never_exceeded() {
         );
         let rd_u = rd_upper(&profile, &ic, &sc);
         let g_u = g_upper(&lc, &ic, g_max);
-        let ft_u = ft_upper(&trans);
+        let ft_u = ft_upper(&trans, 1.0);
         let (a, w, i) = (0.1 + u.f(), 0.1 + u.f(), 0.1 + u.f());
         let m = sample_bound(a, w, i, rd_u, g_u, ft_u);
         let e = error_bound(m, 2);

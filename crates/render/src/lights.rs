@@ -88,12 +88,9 @@ pub fn gather(
                 edge_v,
                 radiance,
             } => {
-                let cross = edge_u.cross(*edge_v);
-                let area = cross.length();
-                if !(area > 0.0) {
+                let Some((area, nl)) = quad_area_normal(*edge_u, *edge_v) else {
                     continue;
-                }
-                let nl = cross / area;
+                };
                 for k in 0..m {
                     let (s, t) = stratum(k, m, rng);
                     let y = *corner + *edge_u * s + *edge_v * t;
@@ -156,6 +153,14 @@ fn push(out: &mut Vec<Incident>, dir: DVec3, e_cos: Rgb) {
     if e_cos.iter().all(|v| v.is_finite() && *v >= 0.0) && e_cos.iter().any(|v| *v > 0.0) {
         out.push(Incident { dir, e_cos });
     }
+}
+
+/// The area and unit normal (edge_u × edge_v, normalised) of a quad light, `None` for a
+/// degenerate or non-finite one (which emits nothing).
+pub(crate) fn quad_area_normal(edge_u: DVec3, edge_v: DVec3) -> Option<(f64, DVec3)> {
+    let cross = edge_u.cross(edge_v);
+    let area = cross.length();
+    (area > 0.0 && area.is_finite()).then(|| (area, cross / area))
 }
 
 /// A point of the unit square in stratum `k` of `m` equal strips along the first axis (uniform

@@ -90,12 +90,9 @@ pub fn scene_vpls(
                 edge_v,
                 radiance,
             } => {
-                let cross = edge_u.cross(*edge_v);
-                let area = cross.length();
-                if !(area > 0.0) {
+                let Some((area, n)) = crate::lights::quad_area_normal(*edge_u, *edge_v) else {
                     continue;
-                }
-                let n = cross / area;
+                };
                 // A jittered nu × nv grid with nu·nv = m exactly (nu the largest divisor of m
                 // up to √m: 32 × 32 for 1024, 1 × m for a prime), so the points are uniform on
                 // the quad and stratified in both directions when m has a good factorisation.

@@ -6,6 +6,31 @@
 use glam::DVec3;
 use sss_manylight::*;
 
+/// A seeded stream of uniforms in [0, 1) (splitmix64 over a Weyl sequence), for the tests'
+/// random configurations.
+pub struct U(pub u64);
+
+impl U {
+    /// A uniform in [0, 1).
+    pub fn f(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        (sss_util::splitmix64_mix(self.0) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// A point of the unit cube.
+    pub fn v(&mut self) -> DVec3 {
+        DVec3::new(self.f(), self.f(), self.f())
+    }
+
+    /// A uniformly distributed unit vector (Archimedes: z uniform in [−1, 1]).
+    pub fn dir(&mut self) -> DVec3 {
+        let z = 2.0 * self.f() - 1.0;
+        let phi = std::f64::consts::TAU * self.f();
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+    }
+}
+
 /// Decay lengths of the test profile per channel.
 pub const ELL: [f64; 3] = [0.3, 0.2, 0.1];
 /// Amplitudes of the test profile per channel.

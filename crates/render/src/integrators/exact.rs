@@ -177,12 +177,14 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
         }
         return sum;
     }
-    for s in &samples.samples {
-        let rd = shading.rd_sample_scene((s.position - g.p).length(), s.area);
-        for c in 0..3 {
-            sum[c] += rd[c] * s.irradiance[c] * s.area;
-        }
-    }
+    shading.add_point_sum(
+        &mut sum,
+        g.p,
+        samples
+            .samples
+            .iter()
+            .map(|s| (s.position, s.area, s.irradiance)),
+    );
     let mut out = [0.0; 3];
     add_scaled(&mut out, sum, shading.exit_weight(g.n, g.wo));
     out

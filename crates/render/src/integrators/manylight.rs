@@ -43,7 +43,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{Rgb, make_model};
-use sss_manylight::irradiance_cluster::{IcNode, SplitNode};
+use sss_manylight::irradiance_cluster::IcNode;
 use sss_manylight::{
     Estimator, IrradianceTree, LightNode, LightTree, RadialProfile, Refinements, Selection,
     Settings, ShadingPoint, ShadingTree, StudentT, Summary, Transmittance, Triangle, Vpl,
@@ -52,7 +52,7 @@ use sss_manylight::{
 use sss_scene::Scene;
 
 /// The options of `manylight`.
-pub const OPTIONS: [OptionSpec; 5] = [
+pub const OPTIONS: [OptionSpec; 6] = [
     OptionSpec {
         name: "eps",
         value_name: "E",
@@ -84,8 +84,15 @@ pub const OPTIONS: [OptionSpec; 5] = [
     OptionSpec {
         name: "max-triplets",
         value_name: "N",
-        default: "100000",
+        default: "200000",
         help: "Cap on the triplets of one pixel and object (pixels at the cap are counted and warned about)",
+        kind: OptionKind::Value,
+    },
+    OptionSpec {
+        name: "max-splits",
+        value_name: "N",
+        default: "200000",
+        help: "Cap on the triangle splits of one pixel and object, about 400 bytes each, allocated as needed (pixels at the cap are counted and warned about)",
         kind: OptionKind::Value,
     },
 ];
@@ -125,6 +132,8 @@ pub struct ManyLight {
     pub vpls: u32,
     /// Cap on the triplets per pixel and object.
     pub max_triplets: usize,
+    /// Cap on the triangle splits per pixel and object.
+    pub max_splits: usize,
 }
 
 impl Default for ManyLight {
@@ -134,7 +143,8 @@ impl Default for ManyLight {
             alpha: 0.95,
             selection: Selection::BssrdfAware,
             vpls: 1024,
-            max_triplets: 100_000,
+            max_triplets: 200_000,
+            max_splits: 200_000,
         }
     }
 }
@@ -176,12 +186,19 @@ impl ManyLight {
                 "--max-triplets must be in 1..=2^30, got {max_triplets}"
             )));
         }
+        let max_splits: usize = o.get(&OPTIONS, "max-splits")?;
+        if !(1..=(1 << 30)).contains(&max_splits) {
+            return Err(Error::Input(format!(
+                "--max-splits must be in 1..=2^30, got {max_splits}"
+            )));
+        }
         Ok(ManyLight {
             eps,
             alpha,
             selection,
             vpls,
             max_triplets,
+            max_splits,
         })
     }
 }
@@ -337,9 +354,11 @@ impl Integrator for ManyLight {
             .map(|o| scene.objects[o].mesh.triangles.len() as u64)
             .sum();
         let meshes = triangles * (size_of::<Triangle>() + 2 * size_of::<IcNode>()) as u64;
-        // One refinement arena per thread at its cap (two entries per split).
-        let arena = Settings::new(1.0).max_splits as u64 * 2 * size_of::<SplitNode>() as u64;
-        lights + meshes + arena * rayon::current_num_threads() as u64
+        // One pixel's triplets, queue and split arena per thread, at the caps.
+        let mut settings = Settings::new(1.0);
+        settings.max_triplets = self.max_triplets;
+        settings.max_splits = self.max_splits;
+        lights + meshes + settings.peak_pixel_bytes() * rayon::current_num_threads() as u64
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
@@ -353,6 +372,7 @@ impl Integrator for ManyLight {
         settings.epsilon = self.eps;
         settings.selection = self.selection;
         settings.max_triplets = self.max_triplets;
+        settings.max_splits = self.max_splits;
         settings.min_triplets = MIN_TRIPLETS.min(self.max_triplets);
         let t = StudentT::new(self.alpha).map_err(|e| Error::Input(format!("--alpha: {e}")))?;
         let estimators: Vec<Option<Estimator<'_>>> = match &lights {

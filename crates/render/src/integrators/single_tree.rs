@@ -206,7 +206,8 @@ pub(crate) fn inside(node: &KdNode<3>, x: DVec3) -> bool {
     (0..3).all(|k| node.lo[k] <= x[k] && x[k] <= node.hi[k])
 }
 
-/// Adds the contribution Σ R_d(‖x − x_i‖) E_i A_i of `points` at `x` to `acc`.
+/// Adds the point sum of `points` at `x` to `acc`
+/// ([`TranslucentShading::add_point_sum`], as `exact` sums).
 #[inline]
 pub(crate) fn add_samples(
     acc: &mut Rgb,
@@ -214,12 +215,11 @@ pub(crate) fn add_samples(
     x: DVec3,
     sh: &TranslucentShading,
 ) {
-    for p in points {
-        let rd = sh.rd_sample_scene((p.position - x).length(), p.area);
-        for c in 0..3 {
-            acc[c] += rd[c] * p.irradiance[c] * p.area;
-        }
-    }
+    sh.add_point_sum(
+        acc,
+        x,
+        points.iter().map(|p| (p.position, p.area, p.irradiance)),
+    );
 }
 
 /// The sum at `x` over the tree, by Algorithm 1 (before the exit weight).
