@@ -201,6 +201,9 @@ pub struct PixelEstimate {
     pub delta: f64,
     /// Triplets J at the end.
     pub triplets: usize,
+    /// Of those, the triplets with a bound M_j > 0 (the sampled strata): the degrees of freedom
+    /// ν of ΔI's Student-t quantile.
+    pub sampled: usize,
     /// Triangle splits made.
     pub splits: usize,
     /// Splits refused by the cap.
@@ -457,6 +460,7 @@ impl<'a> Estimator<'a> {
             value: sums.value,
             delta: self.delta(sums.bounded, sums.s2),
             triplets: sums.live,
+            sampled: sums.bounded,
             splits: refs.splits(),
             split_cap_hits: refs.cap_hits(),
             frozen,

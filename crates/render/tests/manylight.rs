@@ -321,3 +321,40 @@ fn every_radial_model_and_light_kind_of_picnic_renders() {
     }
     assert!(stat("pixels_converged") > 0.5 * stat("pixel_estimates"));
 }
+
+/// `shade_pixels` gives a pixel subset exactly the values a full render gives those pixels
+/// (each pixel's estimate is seeded by its own index), in the order asked, and refuses a pixel
+/// past the image.
+#[test]
+fn shading_a_subset_equals_the_full_render_there() {
+    let mut s = scene("sphere", 20, 15);
+    s.camera.pixel_samples = 2;
+    let settings = RenderSettings::default();
+    let m = integrators::manylight::ManyLight {
+        eps: 0.05,
+        ..Default::default()
+    };
+    let full = render(&s, &m, &settings, &NoProgress).unwrap();
+    let frame = Frame::prepare(&s, settings.seed);
+    let lit: Vec<usize> = (0..full.subsurface.len())
+        .filter(|&i| lum(full.subsurface[i]) > 0.0)
+        .collect();
+    assert!(lit.len() > 40, "{} lit pixels", lit.len());
+    // Every fifth lit pixel, in reverse order, plus one black pixel.
+    let black = (0..full.subsurface.len())
+        .find(|&i| lum(full.subsurface[i]) == 0.0)
+        .unwrap();
+    let mut pick: Vec<usize> = lit.iter().copied().step_by(5).rev().collect();
+    pick.push(black);
+    let sub = m.shade_pixels(&frame, &pick).unwrap();
+    assert_eq!(sub.len(), pick.len());
+    let se = full.std_error.as_ref().unwrap();
+    for (r, &i) in sub.iter().zip(&pick) {
+        assert_eq!(r.subsurface, full.subsurface[i], "pixel {i}");
+        assert_eq!(r.std_error, se[i], "pixel {i}");
+    }
+    assert_eq!(sub.last().unwrap().subsurface, [0.0; 3]);
+    let n = full.subsurface.len();
+    let err = m.shade_pixels(&frame, &[n]).unwrap_err().to_string();
+    assert!(err.contains("past the image"), "{err}");
+}

@@ -323,45 +323,29 @@ fn object_data(frame: &Frame<'_>, method: &str) -> Result<Vec<Option<ObjectData>
     Ok(out)
 }
 
-impl Integrator for ManyLight {
-    fn name(&self) -> &'static str {
-        METHOD.name
-    }
+/// What [`ManyLight::shade_pixels`] gives one pixel.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PixelResult {
+    /// The pixel's subsurface value, assembled as the renderer assembles it.
+    pub subsurface: Rgb,
+    /// The standard error of each channel (from ΔI of each object's estimate).
+    pub std_error: Rgb,
+    /// Triplets over the pixel's objects.
+    pub triplets: f64,
+    /// The counters of the pixel's estimates.
+    pub summary: Summary,
+}
 
-    fn describe(&self) -> String {
-        format!(
-            "eps {}, alpha {}, {} selection, {} VPLs per area/environment light, direct light only",
-            self.eps,
-            self.alpha,
-            match self.selection {
-                Selection::BssrdfAware => "BSSRDF-aware",
-                Selection::MaxExtent => "Max-Extent",
-            },
-            self.vpls
-        )
-    }
-
-    fn layer_names(&self) -> &'static [&'static str] {
-        &["triplets"]
-    }
-
-    fn structure_bytes(&self, scene: &Scene, _samples: &[(usize, u64, u64)]) -> u64 {
-        let n = vpl_count(&scene.lights, self.vpls);
-        let lights =
-            n * size_of::<Vpl>() as u64 + (2 * n).saturating_sub(1) * size_of::<LightNode>() as u64;
-        let triangles: u64 = (0..scene.objects.len())
-            .filter(|&o| scene.translucent(o).is_some())
-            .map(|o| scene.objects[o].mesh.triangles.len() as u64)
-            .sum();
-        let meshes = triangles * (size_of::<Triangle>() + 2 * size_of::<IcNode>()) as u64;
-        // One pixel's triplets, queue and split arena per thread, at the caps.
-        let mut settings = Settings::new(1.0);
-        settings.max_triplets = self.max_triplets;
-        settings.max_splits = self.max_splits;
-        lights + meshes + settings.peak_pixel_bytes() * rayon::current_num_threads() as u64
-    }
-
-    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+impl ManyLight {
+    /// The estimates of the pixels `only` of `frame` (all pixels when `None`), in that order,
+    /// with the settings used, the VPL count and the G clamp. Shared by the integrator and by
+    /// [`ManyLight::shade_pixels`].
+    fn estimate_pixels(
+        &self,
+        frame: &Frame<'_>,
+        only: Option<&[usize]>,
+        progress: &dyn Progress,
+    ) -> Result<(Vec<PixelOut>, Settings, usize, f64), Error> {
         check_radial(frame, METHOD.name)?;
         let scene = frame.scene;
         let objects = frame.timed("irradiance_tree", || object_data(frame, METHOD.name))?;
@@ -404,83 +388,166 @@ impl Integrator for ManyLight {
             !geom.occluded(xi, d / dist, eps_ray, dist - eps_ray)
         };
         let gb = &frame.gbuffer;
+        let n = gb.pixels();
+        if let Some(&bad) = only.and_then(|p| p.iter().find(|&&i| i >= n)) {
+            return Err(Error::Input(format!(
+                "manylight: pixel {bad} is past the image's {n} pixels"
+            )));
+        }
+        let list: Vec<usize> = only.map_or_else(|| (0..n).collect(), <[usize]>::to_vec);
         let spp = gb.samples_per_pixel as f64;
         let max_splits = settings.max_splits;
+        let shade = |refs: &mut Refinements, i: usize| -> Result<PixelOut, Error> {
+            let samples = gb.pixel(i);
+            let mut out = PixelOut {
+                values: vec![[0.0; 3]; samples.len()],
+                ..PixelOut::default()
+            };
+            let mut var = [0.0; 3];
+            let mut done: Vec<u32> = Vec::new();
+            for g in samples {
+                let o = g.object;
+                if done.contains(&o) {
+                    continue;
+                }
+                done.push(o);
+                let (Some(sh), Some(Some(est))) = (frame.shading_of(o), estimators.get(o as usize))
+                else {
+                    continue;
+                };
+                let mut points = Vec::new();
+                let mut members = Vec::new();
+                for (k, s) in samples.iter().enumerate() {
+                    if s.object == o {
+                        let e = sh.exit_weight(s.n, s.wo);
+                        points.push(ShadingPoint {
+                            position: s.p,
+                            normal: s.n,
+                            weight: e / spp,
+                        });
+                        members.push((k, e));
+                    }
+                }
+                let e_sum: f64 = members.iter().map(|m| m.1).sum();
+                if !(e_sum > 0.0) {
+                    continue;
+                }
+                let tree = ShadingTree::new(points).map_err(|e| model_error(scene, o, e))?;
+                let seed = pixel_seed(
+                    sss_util::splitmix64(frame.seed ^ sss_util::splitmix64(u64::from(o))),
+                    i as u64,
+                );
+                let px = est.estimate_with(&tree, &visibility, seed, refs);
+                out.summary.add(&px);
+                out.triplets += px.triplets as f64;
+                for (k, e) in members {
+                    for c in 0..3 {
+                        out.values[k][c] = px.rgb[c].max(0.0) * spp * e / e_sum;
+                    }
+                }
+                // The standard error of the luminance, ΔI / t_α(J), given to each
+                // channel in proportion to its value.
+                if px.sampled > 0 && px.value > 0.0 {
+                    let se = px.delta / t.quantile(px.sampled);
+                    for c in 0..3 {
+                        let s = px.rgb[c].max(0.0) * se / px.value;
+                        var[c] += s * s;
+                    }
+                }
+            }
+            out.std_error = var.map(f64::sqrt);
+            Ok(out)
+        };
         let pixels: Vec<PixelOut> = frame.timed("shading", || {
-            (0..gb.pixels())
-                .into_par_iter()
+            list.par_iter()
                 .with_min_len(8)
                 .map_init(
                     || Refinements::new(max_splits),
-                    |refs, i| {
-                        let samples = gb.pixel(i);
-                        let mut out = PixelOut {
-                            values: vec![[0.0; 3]; samples.len()],
-                            ..PixelOut::default()
-                        };
-                        let mut var = [0.0; 3];
-                        let mut done: Vec<u32> = Vec::new();
-                        for g in samples {
-                            let o = g.object;
-                            if done.contains(&o) {
-                                continue;
-                            }
-                            done.push(o);
-                            let (Some(sh), Some(Some(est))) =
-                                (frame.shading_of(o), estimators.get(o as usize))
-                            else {
-                                continue;
-                            };
-                            let mut points = Vec::new();
-                            let mut members = Vec::new();
-                            for (k, s) in samples.iter().enumerate() {
-                                if s.object == o {
-                                    let e = sh.exit_weight(s.n, s.wo);
-                                    points.push(ShadingPoint {
-                                        position: s.p,
-                                        normal: s.n,
-                                        weight: e / spp,
-                                    });
-                                    members.push((k, e));
-                                }
-                            }
-                            let e_sum: f64 = members.iter().map(|m| m.1).sum();
-                            if !(e_sum > 0.0) {
-                                continue;
-                            }
-                            let tree =
-                                ShadingTree::new(points).map_err(|e| model_error(scene, o, e))?;
-                            let seed = pixel_seed(
-                                sss_util::splitmix64(
-                                    frame.seed ^ sss_util::splitmix64(u64::from(o)),
-                                ),
-                                i as u64,
-                            );
-                            let px = est.estimate_with(&tree, &visibility, seed, refs);
-                            out.summary.add(&px);
-                            out.triplets += px.triplets as f64;
-                            for (k, e) in members {
-                                for c in 0..3 {
-                                    out.values[k][c] = px.rgb[c].max(0.0) * spp * e / e_sum;
-                                }
-                            }
-                            // The standard error of the luminance, ΔI / t_α(J), given to each
-                            // channel in proportion to its value.
-                            if px.triplets > 0 && px.value > 0.0 {
-                                let se = px.delta / t.quantile(px.triplets);
-                                for c in 0..3 {
-                                    let s = px.rgb[c].max(0.0) * se / px.value;
-                                    var[c] += s * s;
-                                }
-                            }
-                        }
-                        out.std_error = var.map(f64::sqrt);
-                        progress.advance(samples.len() as u64);
-                        Ok(out)
+                    |refs, &i| {
+                        let out = shade(refs, i);
+                        progress.advance(gb.pixel(i).len() as u64);
+                        out
                     },
                 )
                 .collect::<Result<Vec<PixelOut>, Error>>()
         })?;
+        let n_vpls = lights.as_ref().map_or(0, |l| l.vpls().len());
+        Ok((pixels, settings, n_vpls, g_max))
+    }
+
+    /// The estimates of the pixels `pixels` of `frame` only (for subset references and
+    /// accuracy measurements): each pixel's subsurface value equals what a full render gives
+    /// it with the same seed, since every pixel's estimate is seeded by its own index.
+    pub fn shade_pixels(
+        &self,
+        frame: &Frame<'_>,
+        pixels: &[usize],
+    ) -> Result<Vec<PixelResult>, Error> {
+        let (outs, _, _, _) =
+            self.estimate_pixels(frame, Some(pixels), &crate::progress::NoProgress)?;
+        let gb = &frame.gbuffer;
+        Ok(outs
+            .into_iter()
+            .zip(pixels)
+            .map(|(o, &i)| {
+                let vals: Vec<Option<Rgb>> = gb
+                    .pixel(i)
+                    .iter()
+                    .zip(&o.values)
+                    .map(|(g, v)| frame.shading_of(g.object).map(|_| *v))
+                    .collect();
+                PixelResult {
+                    subsurface: crate::render::assembled_subsurface(&vals, gb.samples_per_pixel),
+                    std_error: o.std_error,
+                    triplets: o.triplets,
+                    summary: o.summary,
+                }
+            })
+            .collect())
+    }
+}
+
+impl Integrator for ManyLight {
+    fn name(&self) -> &'static str {
+        METHOD.name
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "eps {}, alpha {}, {} selection, {} VPLs per area/environment light, direct light only",
+            self.eps,
+            self.alpha,
+            match self.selection {
+                Selection::BssrdfAware => "BSSRDF-aware",
+                Selection::MaxExtent => "Max-Extent",
+            },
+            self.vpls
+        )
+    }
+
+    fn layer_names(&self) -> &'static [&'static str] {
+        &["triplets"]
+    }
+
+    fn structure_bytes(&self, scene: &Scene, _samples: &[(usize, u64, u64)]) -> u64 {
+        let n = vpl_count(&scene.lights, self.vpls);
+        let lights =
+            n * size_of::<Vpl>() as u64 + (2 * n).saturating_sub(1) * size_of::<LightNode>() as u64;
+        let triangles: u64 = (0..scene.objects.len())
+            .filter(|&o| scene.translucent(o).is_some())
+            .map(|o| scene.objects[o].mesh.triangles.len() as u64)
+            .sum();
+        let meshes = triangles * (size_of::<Triangle>() + 2 * size_of::<IcNode>()) as u64;
+        // One pixel's triplets, queue and split arena per thread, at the caps.
+        let mut settings = Settings::new(1.0);
+        settings.max_triplets = self.max_triplets;
+        settings.max_splits = self.max_splits;
+        lights + meshes + settings.peak_pixel_bytes() * rayon::current_num_threads() as u64
+    }
+
+    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        let gb = &frame.gbuffer;
+        let (pixels, settings, n_vpls, g_max) = self.estimate_pixels(frame, None, progress)?;
         let mut summary = Summary::default();
         let mut values = Vec::with_capacity(gb.samples.len());
         let mut std_error = Vec::with_capacity(pixels.len());
@@ -491,7 +558,6 @@ impl Integrator for ManyLight {
             std_error.push(p.std_error);
             triplets.push([p.triplets; 3]);
         }
-        let n_vpls = lights.as_ref().map_or(0, |l| l.vpls().len());
         if summary.triplet_cap + summary.split_cap + summary.exhausted > 0 {
             frame.warn(format!(
                 "manylight: {} pixel estimates stopped at the triplet cap ({}), {} hit the split \
