@@ -12,6 +12,7 @@
 
 mod checked;
 mod kernels;
+mod manylight;
 mod metrics;
 mod output;
 mod profiles;
@@ -64,6 +65,15 @@ pub struct Config {
     pub quick: bool,
     /// Run only the paper-scale tree experiments ([`trees`]).
     pub trees: bool,
+    /// Run only the paper-scale many-light experiments ([`manylight`]).
+    pub manylight: bool,
+}
+
+impl Config {
+    /// True when only paper-scale experiments run (they use no Monte Carlo reference).
+    pub fn paper_only(&self) -> bool {
+        self.trees || self.manylight
+    }
 }
 
 /// A failure, with a message for a person.
@@ -107,8 +117,15 @@ pub trait Experiment {
 
 /// Every experiment, in report order.
 fn experiments(config: &Config) -> Vec<Box<dyn Experiment>> {
-    if config.trees {
-        return vec![Box::new(trees::TreeExperiment)];
+    if config.paper_only() {
+        let mut v: Vec<Box<dyn Experiment>> = Vec::new();
+        if config.trees {
+            v.push(Box::new(trees::TreeExperiment));
+        }
+        if config.manylight {
+            v.push(Box::new(manylight::ManyLightExperiment));
+        }
+        return v;
     }
     vec![
         Box::new(profiles::ProfileComparison),
@@ -161,7 +178,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
             bar.println(msg);
         }
     };
-    if !config.trees {
+    if !config.paper_only() {
         log(&format!(
             "compare: {} preset(s), {} photons per channel, seed {}, {} bins -> {}",
             presets.len(),
@@ -171,8 +188,8 @@ pub fn run(config: &Config) -> Result<(), Error> {
             config.out.display()
         ));
     }
-    // The tree experiments use no Monte Carlo reference.
-    let references = if config.trees {
+    // The paper-scale experiments use no Monte Carlo reference.
+    let references = if config.paper_only() {
         Vec::new()
     } else {
         reference::load_or_compute(config, &presets, &log, &bar)?

@@ -134,6 +134,13 @@ pub struct ManyLight {
     pub max_triplets: usize,
     /// Cap on the triangle splits per pixel and object.
     pub max_splits: usize,
+    /// Seed of the VPL sampling (`None`: the render's seed). Fixing it keeps one VPL set, and
+    /// so one integral, across renders of different seeds, as the paper's comparisons do.
+    pub vpl_seed: Option<u64>,
+    /// Mixed into every pixel estimate's seed (0 by default): another stream gives an
+    /// independent estimate over the same G-buffer and VPLs (the frame's seed also places the
+    /// camera samples, so changing it changes the pixel values being estimated).
+    pub stream: u64,
 }
 
 impl Default for ManyLight {
@@ -145,6 +152,8 @@ impl Default for ManyLight {
             vpls: 1024,
             max_triplets: 200_000,
             max_splits: 200_000,
+            vpl_seed: None,
+            stream: 0,
         }
     }
 }
@@ -199,6 +208,8 @@ impl ManyLight {
             vpls,
             max_triplets,
             max_splits,
+            vpl_seed: None,
+            stream: 0,
         })
     }
 }
@@ -259,10 +270,15 @@ fn scene_box(frame: &Frame<'_>) -> (DVec3, f64) {
     }
 }
 
-/// Builds the light tree of the frame's VPLs (`None` without light). Shared with the baselines.
-pub(crate) fn light_tree(frame: &Frame<'_>, budget: u32) -> Result<Option<LightTree>, Error> {
+/// Builds the light tree of the frame's VPLs, drawn from `seed` (the frame's seed unless a
+/// run fixes another), or `None` without light. Shared with the baselines.
+pub(crate) fn light_tree_seeded(
+    frame: &Frame<'_>,
+    budget: u32,
+    seed: u64,
+) -> Result<Option<LightTree>, Error> {
     let (center, _) = scene_box(frame);
-    let vpls = scene_vpls(frame.scene, budget, frame.seed, center, frame.geom.extent())?;
+    let vpls = scene_vpls(frame.scene, budget, seed, center, frame.geom.extent())?;
     if vpls.is_empty() {
         return Ok(None);
     }
@@ -349,7 +365,10 @@ impl ManyLight {
         check_radial(frame, METHOD.name)?;
         let scene = frame.scene;
         let objects = frame.timed("irradiance_tree", || object_data(frame, METHOD.name))?;
-        let lights = frame.timed("light_tree", || light_tree(frame, self.vpls))?;
+        let vpl_seed = self.vpl_seed.unwrap_or(frame.seed);
+        let lights = frame.timed("light_tree", || {
+            light_tree_seeded(frame, self.vpls, vpl_seed)
+        })?;
         let (_, half_diag) = scene_box(frame);
         let g_max = Settings::g_max_for_scene(half_diag);
         let mut settings = Settings::new(g_max);
@@ -433,10 +452,11 @@ impl ManyLight {
                     continue;
                 }
                 let tree = ShadingTree::new(points).map_err(|e| model_error(scene, o, e))?;
-                let seed = pixel_seed(
-                    sss_util::splitmix64(frame.seed ^ sss_util::splitmix64(u64::from(o))),
-                    i as u64,
-                );
+                let mut object_seed = frame.seed ^ sss_util::splitmix64(u64::from(o));
+                if self.stream != 0 {
+                    object_seed ^= sss_util::splitmix64(self.stream ^ 0x5354_5245_414d);
+                }
+                let seed = pixel_seed(sss_util::splitmix64(object_seed), i as u64);
                 let px = est.estimate_with(&tree, &visibility, seed, refs);
                 out.summary.add(&px);
                 out.triplets += px.triplets as f64;
