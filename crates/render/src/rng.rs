@@ -21,6 +21,8 @@ pub enum Stream {
     Placement = 5,
     /// Virtual point lights sampled on area and environment lights (per light).
     Vpl = 6,
+    /// Light paths traced for one-bounce VPLs (per light).
+    Bounce = 7,
 }
 
 /// The generator for work item `index` of `stream` under `seed`.

@@ -2,8 +2,8 @@
 //! (`manylight`; Keller 1997, "Instant radiosity"; Walter et al. 2005/2006, Lightcuts and
 //! Multidimensional Lightcuts).
 //!
-//! Direct light only (no indirect bounce), so that many-light renders are comparable with
-//! `exact` and `pathtrace`, which carry direct light only:
+//! [`scene_vpls`] makes the VPLs of direct light, so that many-light renders are comparable
+//! with `exact` and `pathtrace`, which carry direct light only:
 //!
 //! * a **point light** is one isotropic VPL of its intensity;
 //! * a **directional light** (irradiance E along direction d) is one isotropic VPL placed
@@ -18,13 +18,23 @@
 //!
 //! Sampling is seeded per light from the render seed (stream [`Stream::Vpl`]), so the VPLs,
 //! and every image built from them, are the same for any thread count.
+//!
+//! **One indirect bounce** ([`bounce_vpls`], off unless asked for): light paths are traced
+//! from the lights (Keller 1997's instant radiosity, one bounce), each light getting paths in
+//! proportion to its power; where a path first meets an opaque diffuse surface it leaves a
+//! cosine VPL facing the side the light came from, of intensity Φ_path ρ / π (a Lambertian
+//! reflector of albedo ρ re-emits ρ Φ_path, and a cosine emitter of intensity I along its
+//! normal emits π I). A path whose first hit is translucent, or that leaves the scene, leaves
+//! nothing (light inside translucent objects is the BSSRDF's business). Renders with it carry
+//! more light than `exact` and `pathtrace`, which carry direct light only.
 
 use crate::Error;
+use crate::geometry::SceneGeometry;
 use crate::rng::{Stream, rng};
 use glam::DVec3;
 use rand::RngExt;
 use sss_manylight::Vpl;
-use sss_scene::{Light, Scene};
+use sss_scene::{Light, MaterialKind, Scene};
 use std::f64::consts::PI;
 
 /// Distant lights (directional, environment) are placed this many scene extents away.
@@ -124,4 +134,140 @@ pub fn scene_vpls(
         }
     }
     Ok(out)
+}
+
+/// The power (W, per channel) a light sends into a scene whose geometry lies in the sphere of
+/// radius `radius`: 4πI for a point light, πR²E for a directional one, πLA for a quad,
+/// 4π²R²L for an environment (its radiance through the sphere, πL per unit area of 4πR²).
+pub fn light_power(light: &Light, radius: f64) -> [f64; 3] {
+    let disk = PI * radius * radius;
+    match light {
+        Light::Point { intensity, .. } => intensity.map(|i| 4.0 * PI * i),
+        Light::Directional { irradiance, .. } => irradiance.map(|e| e * disk),
+        Light::Quad {
+            edge_u,
+            edge_v,
+            radiance,
+            ..
+        } => {
+            let a = crate::lights::quad_area_normal(*edge_u, *edge_v).map_or(0.0, |q| q.0);
+            radiance.map(|l| PI * l * a)
+        }
+        Light::Environment { radiance } => radiance.map(|l| 4.0 * PI * disk * l),
+    }
+}
+
+/// A uniformly distributed unit vector from two uniforms (Archimedes: z uniform).
+fn uniform_sphere(u1: f64, u2: f64) -> DVec3 {
+    let z = 1.0 - 2.0 * u1;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u2;
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// A point of the disk of radius `r` about `c` perpendicular to the unit `d`, uniform by area.
+fn disk_point(c: DVec3, d: DVec3, r: f64, u1: f64, u2: f64) -> DVec3 {
+    let (a, b) = crate::lights::tangent_frame(d);
+    let rho = r * u1.sqrt();
+    let phi = 2.0 * PI * u2;
+    c + a * (rho * phi.cos()) + b * (rho * phi.sin())
+}
+
+/// One-bounce VPLs (see the module doc): `paths` light paths in all, split over the lights in
+/// proportion to their power (luminance), each light's paths carrying its power equally,
+/// traced against `geom`, seeded by `seed` (stream [`Stream::Bounce`], per light). `center`
+/// and `radius` bound the geometry (distant lights enter through that sphere). `paths` = 0
+/// gives none.
+pub fn bounce_vpls(
+    scene: &Scene,
+    geom: &SceneGeometry,
+    paths: u32,
+    seed: u64,
+    center: DVec3,
+    radius: f64,
+) -> Vec<Vpl> {
+    let lum = |c: [f64; 3]| sss_manylight::luminance(c);
+    let radius = radius.max(1e-30);
+    let powers: Vec<[f64; 3]> = scene
+        .lights
+        .iter()
+        .map(|l| light_power(l, radius))
+        .collect();
+    let total: f64 = powers.iter().map(|p| lum(*p).max(0.0)).sum();
+    let mut out = Vec::new();
+    if paths == 0 || !(total > 0.0 && total.is_finite()) {
+        return out;
+    }
+    let eps = 16.0 * geom.epsilon();
+    for (k, light) in scene.lights.iter().enumerate() {
+        let share = lum(powers[k]).max(0.0) / total;
+        let n = (f64::from(paths) * share).round() as u64;
+        if n == 0 {
+            continue;
+        }
+        let phi = powers[k].map(|p| p / n as f64);
+        let mut r = rng(seed, Stream::Bounce, k as u64);
+        for _ in 0..n {
+            let (u1, u2, u3, u4) = (
+                r.random::<f64>(),
+                r.random::<f64>(),
+                r.random::<f64>(),
+                r.random::<f64>(),
+            );
+            let (origin, dir) = match light {
+                Light::Point { position, .. } => (*position, uniform_sphere(u1, u2)),
+                Light::Directional { direction, .. } => {
+                    let d = direction.normalize_or_zero();
+                    if d == DVec3::ZERO {
+                        break;
+                    }
+                    (disk_point(center - 2.0 * radius * d, d, radius, u1, u2), d)
+                }
+                Light::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    ..
+                } => {
+                    let Some((_, nl)) = crate::lights::quad_area_normal(*edge_u, *edge_v) else {
+                        break;
+                    };
+                    // Cosine-weighted about the normal (Malley's method).
+                    let (a, b) = crate::lights::tangent_frame(nl);
+                    let (rr, ph) = (u3.sqrt(), 2.0 * PI * u4);
+                    let z = (1.0 - u3).max(0.0).sqrt();
+                    let d = (a * (rr * ph.cos()) + b * (rr * ph.sin()) + nl * z).normalize();
+                    (*corner + *edge_u * u1 + *edge_v * u2, d)
+                }
+                Light::Environment { .. } => {
+                    let d = uniform_sphere(u3, u4);
+                    (disk_point(center - 2.0 * radius * d, d, radius, u1, u2), d)
+                }
+            };
+            let Some(hit) = geom.closest_hit(origin, dir, eps, f64::INFINITY) else {
+                continue;
+            };
+            let material = &scene.materials[scene.objects[hit.object as usize].material];
+            let MaterialKind::Diffuse { albedo, texture } = &material.kind else {
+                continue;
+            };
+            let tex = texture.as_ref().map_or([1.0; 3], |t| t.eval(hit.p));
+            let facing = if hit.ng.dot(dir) < 0.0 {
+                hit.ng
+            } else {
+                -hit.ng
+            };
+            let intensity: [f64; 3] = std::array::from_fn(|c| phi[c] * albedo[c] * tex[c] / PI);
+            if intensity.iter().all(|v| v.is_finite() && *v >= 0.0)
+                && intensity.iter().any(|v| *v > 0.0)
+            {
+                out.push(Vpl::oriented(
+                    geom.offset(hit.p, hit.ng, -dir),
+                    facing,
+                    intensity,
+                ));
+            }
+        }
+    }
+    out
 }

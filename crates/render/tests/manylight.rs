@@ -358,3 +358,125 @@ fn shading_a_subset_equals_the_full_render_there() {
     let err = m.shade_pixels(&frame, &[n]).unwrap_err().to_string();
     assert!(err.contains("past the image"), "{err}");
 }
+
+/// A square diffuse floor of side 2a under a light, and a small skin sphere standing on it.
+fn floor_scene(light: &str, albedo: f64) -> Scene {
+    let text = format!(
+        r#"
+[camera]
+position = [0.0, 3.0, 6.0]
+target = [0.0, 0.0, 0.0]
+fov = 40.0
+resolution = [24, 18]
+
+{light}
+
+[materials.floor]
+type = "diffuse"
+albedo = {albedo}
+
+[materials.skin]
+type = "translucent"
+model = "better-dipole"
+preset = "skin1"
+units_per_mm = 0.05
+
+[[objects]]
+name = "floor"
+material = "floor"
+shape = "plane"
+size = [4.0, 4.0]
+
+[[objects]]
+name = "ball"
+material = "skin"
+shape = "sphere"
+radius = 0.3
+transform = {{ translate = [1.2, 0.3, 0.0] }}
+"#
+    );
+    sss_render::scene::load_str(&text, "floor.toml", None, &LoadOptions::default()).unwrap()
+}
+
+/// One-bounce VPLs carry the reflected power: under a point light of intensity I at height h
+/// over a square of side 2b, a fraction Ω/4π of the 4πI emitted lands on it (Ω = 4 arcsin(b²/
+/// (b² + h²)), the solid angle of the square from a point on its axis), of which the floor
+/// (albedo ρ) re-emits ρ; a cosine VPL of intensity I_v emits π I_v. Under a directional light
+/// of irradiance E straight down the floor receives E (2b)². Every VPL lies on the floor's top
+/// (none on the translucent ball, none underneath) and faces up.
+#[test]
+fn bounce_vpls_carry_the_reflected_power() {
+    let (h, b, rho, intensity) = (2.0f64, 2.0f64, 0.6, 10.0);
+    let point = floor_scene(
+        &format!(
+            "[[lights]]\ntype = \"point\"\nposition = [0.0, {h}, 0.0]\nintensity = {intensity}\n"
+        ),
+        rho,
+    );
+    let dir = floor_scene(
+        "[[lights]]\ntype = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nirradiance = 3.0\n",
+        rho,
+    );
+    let omega = 4.0 * (b * b / (b * b + h * h)).asin();
+    // The ball (radius 0.3 at (1.2, 0.3, 0)) shadows the floor: from the point light it covers
+    // the solid angle 2π(1 − cos α), sin α = r / distance, and its shadow lies on the floor;
+    // under the directional light it hides a disk of area πr².
+    let (r, c) = (0.3f64, DVec3::new(1.2, 0.3, 0.0));
+    let sin_a = r / c.distance(DVec3::new(0.0, h, 0.0));
+    let omega_ball = 2.0 * PI * (1.0 - (1.0 - sin_a * sin_a).sqrt());
+    let paths = 40_000u32;
+    for (s, want) in [
+        (&point, rho * intensity * (omega - omega_ball)),
+        (&dir, rho * 3.0 * ((2.0 * b) * (2.0 * b) - PI * r * r)),
+    ] {
+        let frame = Frame::prepare(s, 1);
+        let (lo, hi) = (0..s.objects.len() as u32)
+            .filter_map(|o| frame.geom.bounds(o))
+            .fold(
+                (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+                |(a, c), (p, q)| (a.min(p), c.max(q)),
+            );
+        let (center, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
+        let v = sss_render::vpls::bounce_vpls(s, &frame.geom, paths, 7, center, radius);
+        let total: f64 = v.iter().map(|x| PI * x.intensity[0]).sum();
+        // Each path lands with probability p; the sum is (power / N) × hits.
+        let power = sss_render::vpls::light_power(&s.lights[0], radius)[0];
+        let p = (want / rho / power).min(1.0);
+        let se = want * ((1.0 - p) / (p * f64::from(paths))).sqrt();
+        assert!(
+            (total - want).abs() < 4.0 * se + 1e-9 * want,
+            "reflected power {total} vs {want} ± {se}"
+        );
+        assert!(v.len() > 1000, "{} VPLs", v.len());
+        for x in &v {
+            assert!(
+                x.position.y > 0.0 && x.position.y < 1e-3,
+                "{:?}",
+                x.position
+            );
+            assert_eq!(x.normal, Some(DVec3::Y));
+        }
+    }
+    // Off by default; on, the integrator's light tree holds them and the image brightens.
+    let m0 = integrators::build("manylight", &MethodOptions::new().with("eps", 0.05)).unwrap();
+    let m1 = integrators::build(
+        "manylight",
+        &MethodOptions::new()
+            .with("eps", 0.05)
+            .with("bounce-vpls", 2000),
+    )
+    .unwrap();
+    let settings = RenderSettings::default();
+    let o0 = render(&point, m0.as_ref(), &settings, &NoProgress).unwrap();
+    let o1 = render(&point, m1.as_ref(), &settings, &NoProgress).unwrap();
+    let stat = |o: &sss_render::render::RenderOutput| {
+        o.stats.iter().find(|s| s.name == "vpls").unwrap().value
+    };
+    assert_eq!(stat(&o0), 1.0);
+    // 2000 paths, of which Ω/4π ≈ 16 % land on the floor: about 330 VPLs.
+    assert!((250.0..420.0).contains(&stat(&o1)), "{}", stat(&o1));
+    let sum =
+        |o: &sss_render::render::RenderOutput| o.subsurface.iter().map(|p| lum(*p)).sum::<f64>();
+    assert!(sum(&o1) > 1.02 * sum(&o0), "{} vs {}", sum(&o1), sum(&o0));
+    assert!(m1.describe().contains("one bounce"));
+}

@@ -28,6 +28,10 @@
 //! [`Settings::g_max_for_scene`] of the geometry's half-diagonal: d² ≥ (0.05 × half-diagonal)²,
 //! MDLC's clamp. Reported as the stat `g_max`, with the number of clamped samples.
 //!
+//! **Indirect light** is off by default (renders stay comparable with `exact` and
+//! `pathtrace`); `--bounce-vpls N` adds the VPLs of one bounce off opaque diffuse surfaces
+//! ([`crate::vpls::bounce_vpls`]).
+//!
 //! **Not supported** (clear errors): the directional dipole (not radial) and pre-scatter
 //! textures (the estimator's irradiance has no texture factor).
 
@@ -38,7 +42,7 @@ use super::{
 use crate::Error;
 use crate::frame::Frame;
 use crate::progress::Progress;
-use crate::vpls::{scene_vpls, vpl_count};
+use crate::vpls::{bounce_vpls, scene_vpls, vpl_count};
 use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::fresnel::ft_dielectric;
@@ -52,7 +56,7 @@ use sss_manylight::{
 use sss_scene::Scene;
 
 /// The options of `manylight`.
-pub const OPTIONS: [OptionSpec; 6] = [
+pub const OPTIONS: [OptionSpec; 7] = [
     OptionSpec {
         name: "eps",
         value_name: "E",
@@ -86,6 +90,13 @@ pub const OPTIONS: [OptionSpec; 6] = [
         value_name: "N",
         default: "200000",
         help: "Cap on the triplets of one pixel and object (pixels at the cap are counted and warned about)",
+        kind: OptionKind::Value,
+    },
+    OptionSpec {
+        name: "bounce-vpls",
+        value_name: "N",
+        default: "0",
+        help: "Light paths traced for one indirect bounce off opaque diffuse surfaces, each leaving a VPL where it lands (0: direct light only, comparable with exact and pathtrace)",
         kind: OptionKind::Value,
     },
     OptionSpec {
@@ -134,6 +145,8 @@ pub struct ManyLight {
     pub max_triplets: usize,
     /// Cap on the triangle splits per pixel and object.
     pub max_splits: usize,
+    /// Light paths for one-bounce VPLs ([`crate::vpls::bounce_vpls`]; 0: direct light only).
+    pub bounce_paths: u32,
     /// Seed of the VPL sampling (`None`: the render's seed). Fixing it keeps one VPL set, and
     /// so one integral, across renders of different seeds, as the paper's comparisons do.
     pub vpl_seed: Option<u64>,
@@ -152,6 +165,7 @@ impl Default for ManyLight {
             vpls: 1024,
             max_triplets: 200_000,
             max_splits: 200_000,
+            bounce_paths: 0,
             vpl_seed: None,
             stream: 0,
         }
@@ -195,6 +209,7 @@ impl ManyLight {
                 "--max-triplets must be in 1..=2^30, got {max_triplets}"
             )));
         }
+        let bounce_paths: u32 = o.get(&OPTIONS, "bounce-vpls")?;
         let max_splits: usize = o.get(&OPTIONS, "max-splits")?;
         if !(1..=(1 << 30)).contains(&max_splits) {
             return Err(Error::Input(format!(
@@ -208,6 +223,7 @@ impl ManyLight {
             vpls,
             max_triplets,
             max_splits,
+            bounce_paths,
             vpl_seed: None,
             stream: 0,
         })
@@ -271,14 +287,24 @@ fn scene_box(frame: &Frame<'_>) -> (DVec3, f64) {
 }
 
 /// Builds the light tree of the frame's VPLs, drawn from `seed` (the frame's seed unless a
-/// run fixes another), or `None` without light. Shared with the baselines.
+/// run fixes another): `budget` per area or environment light, plus the one-bounce VPLs of
+/// `bounce_paths` light paths; `None` without light. Shared with the baselines.
 pub(crate) fn light_tree_seeded(
     frame: &Frame<'_>,
     budget: u32,
+    bounce_paths: u32,
     seed: u64,
 ) -> Result<Option<LightTree>, Error> {
-    let (center, _) = scene_box(frame);
-    let vpls = scene_vpls(frame.scene, budget, seed, center, frame.geom.extent())?;
+    let (center, half_diag) = scene_box(frame);
+    let mut vpls = scene_vpls(frame.scene, budget, seed, center, frame.geom.extent())?;
+    vpls.extend(bounce_vpls(
+        frame.scene,
+        &frame.geom,
+        bounce_paths,
+        seed,
+        center,
+        half_diag,
+    ));
     if vpls.is_empty() {
         return Ok(None);
     }
@@ -367,7 +393,7 @@ impl ManyLight {
         let objects = frame.timed("irradiance_tree", || object_data(frame, METHOD.name))?;
         let vpl_seed = self.vpl_seed.unwrap_or(frame.seed);
         let lights = frame.timed("light_tree", || {
-            light_tree_seeded(frame, self.vpls, vpl_seed)
+            light_tree_seeded(frame, self.vpls, self.bounce_paths, vpl_seed)
         })?;
         let (_, half_diag) = scene_box(frame);
         let g_max = Settings::g_max_for_scene(half_diag);
@@ -534,14 +560,19 @@ impl Integrator for ManyLight {
 
     fn describe(&self) -> String {
         format!(
-            "eps {}, alpha {}, {} selection, {} VPLs per area/environment light, direct light only",
+            "eps {}, alpha {}, {} selection, {} VPLs per area/environment light, {}",
             self.eps,
             self.alpha,
             match self.selection {
                 Selection::BssrdfAware => "BSSRDF-aware",
                 Selection::MaxExtent => "Max-Extent",
             },
-            self.vpls
+            self.vpls,
+            if self.bounce_paths == 0 {
+                "direct light only".to_string()
+            } else {
+                format!("one bounce from {} light paths", self.bounce_paths)
+            }
         )
     }
 
@@ -550,7 +581,7 @@ impl Integrator for ManyLight {
     }
 
     fn structure_bytes(&self, scene: &Scene, _samples: &[(usize, u64, u64)]) -> u64 {
-        let n = vpl_count(&scene.lights, self.vpls);
+        let n = vpl_count(&scene.lights, self.vpls) + u64::from(self.bounce_paths);
         let lights =
             n * size_of::<Vpl>() as u64 + (2 * n).saturating_sub(1) * size_of::<LightNode>() as u64;
         let triangles: u64 = (0..scene.objects.len())
