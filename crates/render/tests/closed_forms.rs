@@ -80,6 +80,7 @@ fn scene_of(meshes: Vec<Mesh>, material: Material, lights: Vec<Light>, camera: C
                 name: format!("object{i}"),
                 material: 0,
                 mesh,
+                curvature: None,
             })
             .collect(),
         warnings: Vec::new(),

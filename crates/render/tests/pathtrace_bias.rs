@@ -109,6 +109,7 @@ fn scene() -> Scene {
             name: "sphere".into(),
             material: 0,
             mesh: uv_sphere(1.0, 48, 96),
+            curvature: None,
         }],
         warnings: Vec::new(),
     }
@@ -430,6 +431,7 @@ fn pathtrace_matches_the_flat_slab_closed_form() {
                 positions,
                 triangles,
             },
+            curvature: None,
         }],
         warnings: Vec::new(),
     };

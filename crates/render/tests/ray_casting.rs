@@ -124,6 +124,7 @@ fn scene(width: u32, height: u32, spp: u32) -> Scene {
                 name: format!("object{i}"),
                 material: 0,
                 mesh,
+                curvature: None,
             })
             .collect(),
         warnings: Vec::new(),

@@ -105,6 +105,7 @@ fn scene_with(mesh: Mesh, material: Material, lights: Vec<Light>, camera: Camera
             name: "object".into(),
             material: 0,
             mesh,
+            curvature: None,
         }],
         warnings: Vec::new(),
     }

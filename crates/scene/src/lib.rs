@@ -207,6 +207,56 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+/// The curvature of a procedural shape in closed form, in 1/scene unit after the object's
+/// transform (known only under a uniform scale; `None` in [`Object::curvature`] otherwise, and
+/// for meshes from files and the bumpy sphere, whose curvature is estimated from the mesh).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Curvature {
+    /// The same max(|κ₁|, |κ₂|) everywhere: 1/r on a sphere of radius r; 0 on a plane and on
+    /// the faces of a box (its edges are a set of zero area).
+    Uniform(f64),
+    /// A torus about `axis` through `center`, of major radius `major` and tube radius `minor`:
+    /// κ₁ = 1/minor around the tube and κ₂ = cos v / (major + minor cos v) along it, v the
+    /// angle around the tube from the outer equator (do Carmo 1976, §3-3, Example 4).
+    Torus {
+        /// Centre.
+        center: DVec3,
+        /// Unit axis of revolution.
+        axis: DVec3,
+        /// Distance from the centre to the tube's centre circle.
+        major: f64,
+        /// Tube radius.
+        minor: f64,
+    },
+}
+
+impl Curvature {
+    /// max(|κ₁|, |κ₂|) at the surface point `p` (finite; a point off the surface is taken
+    /// at its angle around the tube).
+    pub fn max_abs_at(&self, p: DVec3) -> f64 {
+        match *self {
+            Curvature::Uniform(k) => k.abs(),
+            Curvature::Torus {
+                center,
+                axis,
+                major,
+                minor,
+            } => {
+                let q = p - center;
+                let rho = (q - axis * q.dot(axis)).length();
+                // cos v = (ρ − R)/r on the surface; κ₂ = cos v/(R + r cos v) = (ρ − R)/(r ρ).
+                let k1 = 1.0 / minor;
+                let k2 = if rho > 0.0 {
+                    ((rho - major) / (minor * rho)).abs()
+                } else {
+                    k1
+                };
+                k1.max(k2)
+            }
+        }
+    }
+}
+
 /// An object: a mesh with a material.
 #[derive(Clone, Debug)]
 pub struct Object {
@@ -216,6 +266,9 @@ pub struct Object {
     pub material: usize,
     /// World-space geometry (at least one triangle).
     pub mesh: Mesh,
+    /// The shape's curvature in closed form, when it is a procedural shape under a uniform
+    /// scale (methods that need curvature estimate it from the mesh otherwise).
+    pub curvature: Option<Curvature>,
 }
 
 /// A problem with a scene file: which file, where in it (line or key, when known), and what.

@@ -336,6 +336,33 @@ impl Transform {
         }
     }
 
+    /// The curvature of a shape after this map, from its object-space closed form: curvature
+    /// scales as 1/s under a uniform scale s and is kept by rotations and translations; `None`
+    /// under a non-uniform scale (the closed forms no longer hold).
+    pub fn curvature(&self, c: crate::Curvature) -> Option<crate::Curvature> {
+        // linear = R·S: its columns' lengths are |s_x|, |s_y|, |s_z|.
+        let s = [0, 1, 2].map(|k| self.linear.col(k).length());
+        let uniform = (s[0] - s[1]).abs() <= 1e-12 * s[0] && (s[0] - s[2]).abs() <= 1e-12 * s[0];
+        if !(uniform && s[0] > 0.0 && s[0].is_finite()) {
+            return None;
+        }
+        let s = s[0];
+        Some(match c {
+            crate::Curvature::Uniform(k) => crate::Curvature::Uniform(k / s),
+            crate::Curvature::Torus {
+                center,
+                axis,
+                major,
+                minor,
+            } => crate::Curvature::Torus {
+                center: self.linear * center + self.translate,
+                axis: (self.linear * axis).normalize(),
+                major: major * s,
+                minor: minor * s,
+            },
+        })
+    }
+
     /// Applies the map to a mesh: positions, normals by the inverse transpose (renormalised in
     /// [`finish`]), and reversed winding when the map mirrors (negative determinant).
     pub fn apply(&self, mut mesh: RawMesh) -> RawMesh {

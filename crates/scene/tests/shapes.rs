@@ -255,3 +255,70 @@ fn transforms() {
         assert!(n.dot(*p) > 0.0);
     }
 }
+
+/// The closed-form curvature of procedural shapes follows the object's transform: 1/(s r) for
+/// a sphere under a uniform scale s, 0 for planes and boxes, none under a non-uniform scale or
+/// for the bumpy sphere; a rotated, scaled, moved torus gives max(1/r, |cos v|/(R + r cos v))
+/// at its vertices (R, r scaled), v the angle around the tube.
+#[test]
+fn analytic_curvature_follows_the_transform() {
+    use sss_scene::Curvature;
+    let curvature_of = |body: &str| {
+        let text = format!("{HEAD}\n[[objects]]\nmaterial = \"m\"\n{body}\n");
+        let scene = load_str(&text, "shape.toml", None, &no_dirs()).unwrap();
+        (scene.objects[0].curvature, scene.objects[0].mesh.clone())
+    };
+    let (c, _) = curvature_of("shape = \"sphere\"\nradius = 0.5\ntransform = { scale = 2.0 }");
+    // A scalar scale applies to every axis.
+    match c {
+        Some(Curvature::Uniform(k)) => assert!((k - 1.0).abs() < 1e-12, "{k}"),
+        other => panic!("{other:?}"),
+    }
+    let (c, _) = curvature_of(
+        "shape = \"sphere\"\nradius = 0.5\ntransform = { scale = [-3.0, 3.0, 3.0], rotate = [10.0, 20.0, 30.0], translate = [1.0, 2.0, 3.0] }",
+    );
+    match c {
+        Some(Curvature::Uniform(k)) => assert!((k - 2.0 / 3.0).abs() < 1e-12, "{k}"),
+        other => panic!("{other:?}"),
+    }
+    let (c, _) =
+        curvature_of("shape = \"sphere\"\nradius = 0.5\ntransform = { scale = [1.0, 2.0, 1.0] }");
+    assert_eq!(c, None);
+    let (c, _) = curvature_of("shape = \"plane\"\nsize = [2.0, 3.0]");
+    assert_eq!(c, Some(Curvature::Uniform(0.0)));
+    let (c, _) = curvature_of("shape = \"box\"\nsize = [1.0, 2.0, 3.0]");
+    assert_eq!(c, Some(Curvature::Uniform(0.0)));
+    let (c, _) =
+        curvature_of("shape = \"bumpy-sphere\"\nradius = 1.0\namplitude = 0.1\nfrequency = 3.0");
+    assert_eq!(c, None);
+    // The torus: at every vertex, compare with the closed form in the torus's own frame.
+    let (c, mesh) = curvature_of(
+        "shape = \"torus\"\nmajor = 1.0\nminor = 0.6\nsegments = [48, 24]\ntransform = { scale = 2.0, rotate = [90.0, 0.0, 30.0], translate = [5.0, -1.0, 2.0] }",
+    );
+    let c = c.expect("a torus under a uniform scale has a closed form");
+    let (big_r, r) = (2.0, 1.2);
+    let center = DVec3::new(5.0, -1.0, 2.0);
+    // The local y axis, rotated 90° about x then 30° about z.
+    let axis = glam::DMat3::from_rotation_z(30f64.to_radians())
+        * glam::DMat3::from_rotation_x(90f64.to_radians())
+        * DVec3::Y;
+    let mut inner = 0;
+    for p in &mesh.positions {
+        let q = *p - center;
+        let h = q.dot(axis);
+        let rho = (q - axis * h).length();
+        // cos v from the point's place around the tube.
+        let cos_v = (rho - big_r) / r;
+        let want = (1.0 / r).max((cos_v / (big_r + r * cos_v)).abs());
+        let got = c.max_abs_at(*p);
+        assert!((got - want).abs() < 1e-9 * want, "{got} vs {want} at {p:?}");
+        if (cos_v / (big_r + r * cos_v)).abs() > 1.0 / r {
+            inner += 1;
+        }
+    }
+    // R < 2r (R = 2, r = 1.2): near the hole |κ₂| (up to 1/(R − r) = 1.25) beats 1/r = 0.83.
+    assert!(inner > 20, "{inner} vertices where κ₂ wins");
+    // On the inner equator, ρ = R − r = 0.8: κ₂ = −1/(R − r).
+    let inner_point = center + axis.any_orthonormal_vector() * 0.8;
+    assert!((c.max_abs_at(inner_point) - 1.25).abs() < 1e-12);
+}

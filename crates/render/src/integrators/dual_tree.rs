@@ -177,17 +177,26 @@ fn rate_at(
 }
 
 /// The G-buffer samples on object `o` (indices, ascending) and the curvature k = max(|κ₁|,
-/// |κ₂|) at each (1/scene unit): per mesh vertex by Rusinkiewicz 2004
-/// ([`vertex_max_abs_curvature`]), interpolated with the hit's barycentric coordinates.
+/// |κ₂|) at each (1/scene unit): in closed form for a procedural shape under a uniform scale
+/// ([`sss_scene::Curvature`]: sphere, plane, box, torus), otherwise per mesh vertex by
+/// Rusinkiewicz 2004 ([`vertex_max_abs_curvature`]), interpolated with the hit's barycentric
+/// coordinates.
 pub fn curvature_at_hits(frame: &Frame<'_>, o: u32) -> Result<(Vec<u32>, Vec<f64>), Error> {
     let object = &frame.scene.objects[o as usize];
+    let index: Vec<u32> = (0..frame.gbuffer.samples.len() as u32)
+        .filter(|&i| frame.gbuffer.samples[i as usize].object == o)
+        .collect();
+    if let Some(c) = object.curvature {
+        let curvature = index
+            .iter()
+            .map(|&i| c.max_abs_at(frame.gbuffer.samples[i as usize].p))
+            .collect();
+        return Ok((index, curvature));
+    }
     let mesh = &object.mesh;
     let coords: Vec<[f64; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
     let k = vertex_max_abs_curvature(&coords, &mesh.triangles)
         .map_err(|e| Error::Input(format!("object `{}`: curvature: {e}", object.name)))?;
-    let index: Vec<u32> = (0..frame.gbuffer.samples.len() as u32)
-        .filter(|&i| frame.gbuffer.samples[i as usize].object == o)
-        .collect();
     let curvature = index
         .par_iter()
         .map(|&i| {

@@ -60,11 +60,12 @@ impl Ctx<'_> {
                     materials.len() - 1
                 });
             let obj_name = o.name.clone().unwrap_or_else(|| format!("object{i}"));
-            let mesh = self.object_mesh(o, &path, &obj_name)?;
+            let (mesh, curvature) = self.object_mesh(o, &path, &obj_name)?;
             objects.push(Object {
                 name: obj_name,
                 material: index,
                 mesh,
+                curvature,
             });
         }
         for (mname, _) in &all_materials {

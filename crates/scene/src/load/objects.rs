@@ -37,12 +37,14 @@ impl Ctx<'_> {
         o: &ObjectDef,
         path: &str,
         name: &str,
-    ) -> Result<crate::Mesh, SceneError> {
+    ) -> Result<(crate::Mesh, Option<crate::Curvature>), SceneError> {
         let present = o.present();
         let key = |k: &str| format!("{path}.{k}");
         let what = format!("shape `{}`", o.shape);
         let shapes_list = ["mesh", "sphere", "plane", "box", "torus", "bumpy-sphere"];
         // The object-space mesh, and the mesh file it came from (named in later messages).
+        // The shape's curvature in object space, for the closed forms of `Curvature`.
+        let mut local_curvature: Option<crate::Curvature> = None;
         let (raw, source): (RawMesh, Option<String>) = match o.shape.as_str() {
             "mesh" => {
                 self.check_keys(path, &present, &["file"], &what)?;
@@ -80,6 +82,7 @@ impl Ctx<'_> {
                     MAX_SPHERE_SUBDIVISIONS,
                     &key("subdivisions"),
                 )?;
+                local_curvature = Some(crate::Curvature::Uniform(1.0 / r));
                 (shapes::sphere(r, n), None)
             }
             "bumpy-sphere" => {
@@ -124,11 +127,13 @@ impl Ctx<'_> {
                 if n == 0 {
                     return Err(self.err(&key("subdivisions"), "must be at least 1"));
                 }
+                local_curvature = Some(crate::Curvature::Uniform(0.0));
                 (shapes::plane(size[0], size[1], n), None)
             }
             "box" => {
                 self.check_keys(path, &present, &["size"], &what)?;
                 let size = self.sizes(o.size.as_deref(), 3, path, &what)?;
+                local_curvature = Some(crate::Curvature::Uniform(0.0));
                 (shapes::cuboid(DVec3::new(size[0], size[1], size[2])), None)
             }
             "torus" => {
@@ -156,6 +161,12 @@ impl Ctx<'_> {
                         ));
                     }
                 }
+                local_curvature = Some(crate::Curvature::Torus {
+                    center: DVec3::ZERO,
+                    axis: DVec3::Y,
+                    major,
+                    minor,
+                });
                 (shapes::torus(major, minor, nu as u32, nv as u32), None)
             }
             other => {
@@ -173,6 +184,7 @@ impl Ctx<'_> {
             None => Transform::new(DVec3::ONE, DVec3::ZERO, DVec3::ZERO),
         };
         let raw = transform.apply(raw);
+        let curvature = local_curvature.and_then(|c| transform.curvature(c));
         let total = raw.triangles.len();
         let (mesh, dropped) = shapes::finish(raw);
         let label = match &source {
@@ -209,7 +221,7 @@ impl Ctx<'_> {
                 mesh.triangles.len()
             ));
         }
-        Ok(mesh)
+        Ok((mesh, curvature))
     }
 
     pub(super) fn subdivisions(
