@@ -21,6 +21,9 @@ pub enum Stream {
     Placement = 5,
     /// Virtual point lights sampled on area and environment lights (per light).
     Vpl = 6,
+    /// The fixed irradiance points of the many-light baselines (`mdlc`, `eelc`; per pixel
+    /// sample).
+    IrradiancePoints = 7,
 }
 
 /// The generator for work item `index` of `stream` under `seed`.
