@@ -8,7 +8,7 @@
 //!
 //! A stratum is a pair (G, L) of a gather cluster and a light cluster, standing for
 //! I_(G,L) = Σ_{i∈G} Σ_{j∈L} S_i ⊙ I_j H(y_j, x_i) (gather points of strength
-//! S = w(x_o) A_k R_d, [`crate::gather_tree`]; H = G V F_t, [`crate::pairs`]). It is sampled
+//! S = w(x_o) A_k R_d, [`crate::gather_tree`]; H = G V F_t, `pairs.rs`). It is sampled
 //! n_j = 2 times (Nabata & Iwasaki Eq. 5–6 with the gather point in the role of the irradiance
 //! and shading points): a gather point i with p = S_i/S_G and a VPL j with p = I_j/I_L by scalar
 //! (luminance) weight, and

@@ -19,7 +19,7 @@
 //! dA wherever p > 0). A **gather point** is one pair (x_o, x_k) folded into one point at x_k
 //! with strength S = w(x_o) A_k R_d(‖x_k − x_o‖) per RGB channel ([`gather_points`]): the
 //! weight of the eye subpath camera → x_o → x_k, as the gather points of Bidirectional Lightcuts
-//! (Walter, Khungurn & Bala 2012, ref. [16] of the paper, which brings BSSRDF importance
+//! (Walter, Khungurn & Bala 2012, ref. \[16\] of the paper, which brings BSSRDF importance
 //! sampling into Lightcuts). R_d is thus known exactly per gather point, and what is left to
 //! cluster is the light transport from the VPLs, I(y) H(y, x_k) with H = G V F_t (Eq. 3 of the
 //! paper), so the pair bounds need no R_d bound (tighter than R_d(r_min) over cluster boxes).

@@ -1,6 +1,6 @@
 //! Multidimensional Lightcuts (Walter, Arbree, Bala & Greenberg, SIGGRAPH 2006) over a fixed
 //! set of BSSRDF importance-sampled (or uniform) irradiance points per shading point, the way
-//! Bidirectional Lightcuts (Walter, Khungurn & Bala 2012, ref. [16] of Nabata & Iwasaki) bring
+//! Bidirectional Lightcuts (Walter, Khungurn & Bala 2012, ref. \[16\] of Nabata & Iwasaki) bring
 //! BSSRDF importance sampling into Lightcuts: the MDLC baseline of Nabata & Iwasaki §5.
 //!
 //! # The cut
@@ -15,7 +15,7 @@
 //! ```
 //!
 //! with one shadow ray. Its error bound is the pair's upper bound
-//! B = H^u(G, L) · LUMINANCE · (Σ S ⊙ Σ I) (H^u of [`crate::pairs`]: MDLC's cosine bound over
+//! B = H^u(G, L) · LUMINANCE · (Σ S ⊙ Σ I) (H^u of `pairs.rs`: MDLC's cosine bound over
 //! the normal cones, the box-to-box distance with the G clamp, F_t at the largest cosine, V ≤ 1):
 //! both the true value and the estimate lie in [0, B]. Starting from the root pair, the pair
 //! with the largest B is refined (one of its clusters replaced by its two children, the one

@@ -398,7 +398,8 @@ fn baselines_agree_with_manylight_within_statistical_error() {
 /// Shadowed and black pixels terminate: on the slab (a wall's shadow over half of it, one
 /// directional light), every pixel estimate ends without the pair cap, finite and ≥ 0; pixels
 /// deep in the shadow are exactly 0 for MDLC (every pair refined to one point and the light) or
-/// stop early for EELC. With the light's power set to 0 every pixel is exactly 0 at once.
+/// stop early for EELC. The pair cap holds. With the light's power set to 0 every pixel is
+/// exactly 0 at once.
 #[test]
 fn baselines_terminate_on_shadowed_and_black_pixels() {
     let s = scene("slab", 32, 24);
@@ -432,6 +433,21 @@ fn baselines_terminate_on_shadowed_and_black_pixels() {
             assert!(
                 out.subsurface.iter().any(|v| lum(*v) > 0.0),
                 "{method}: the lit part is lit"
+            );
+            // The pair cap holds, is counted and warned about (ε = 0 never converges).
+            let capped =
+                integrators::build(method, &o.clone().with("eps", 0).with("max-pairs", 5)).unwrap();
+            let c = render(&s, capped.as_ref(), &settings, &NoProgress).unwrap();
+            let cstat = |n: &str| c.stats.iter().find(|s| s.name == n).unwrap().value;
+            assert!(c.layer("pairs").unwrap().iter().all(|p| p[0] <= 5.0));
+            assert!(
+                cstat("pixels_pair_cap") > 0.5 * cstat("pixel_estimates"),
+                "{method}"
+            );
+            assert!(
+                c.warnings.iter().any(|w| w.contains("pair cap")),
+                "{:?}",
+                c.warnings
             );
             let dark = render(&black, m.as_ref(), &settings, &NoProgress).unwrap();
             let stat = |n: &str| dark.stats.iter().find(|s| s.name == n).unwrap().value;

@@ -34,7 +34,7 @@
 //!
 //! Per thread, one pixel's points: N irradiance points at a time, at most pixel_samples × N
 //! gather points and their tree ([`GatherTree::peak_bytes`]), and the pairs of the cut up to
-//! `--max-pairs`; counted in [`structure_bytes`] against `--max-memory` before the frame is
+//! `--max-pairs`; counted in [`PointOptions::structure_bytes`] against `--max-memory` before the frame is
 //! built.
 //!
 //! # Stages
