@@ -31,7 +31,7 @@
 //! one point per leaf, `binary_tree.rs`); each node holds the box, the normal cone (for the
 //! cosine bound of MDLC, [`crate::cone`]), the summed RGB strength and its luminance, the
 //! largest chroma factor below (see [`GatherNode::chroma`]) and a representative point chosen
-//! at random in proportion to strength from its children (Walter et al. 2006 §4: that choice
+//! at random in proportion to strength from its children (as MDLC picks them: that choice
 //! makes the representative's estimate of a cluster unbiased over the choice), seeded so that
 //! the tree is a function of its input and seed.
 

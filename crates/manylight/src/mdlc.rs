@@ -8,7 +8,8 @@
 //! The product graph pairs a node of the pixel's [`GatherTree`] (gather points: irradiance
 //! points carrying w(x_o) A_k R_d, see [`crate::gather_tree`]) with a node of the shared
 //! [`LightTree`]. A pair (G, L) stands for Σ_{i∈G} Σ_{j∈L} S_i ⊙ I_j H(y_j, x_i), and MDLC
-//! estimates it from the representatives (Walter et al. 2006 Eq. 4):
+//! estimates it from the representatives (the cluster-pair approximation of Walter et al.
+//! 2006, as in Lightcuts):
 //!
 //! ```text
 //! Î_(G,L) = H(y_rep(L), x_rep(G)) · (Σ_{i∈G} S_i) ⊙ (Σ_{j∈L} I_j)      (per RGB channel)
@@ -20,10 +21,10 @@
 //! both the true value and the estimate lie in [0, B]. Starting from the root pair, the pair
 //! with the largest B is refined (one of its clusters replaced by its two children, the one
 //! with the longer box diagonal, as MDLC) until every pair's bound is below ε times the current
-//! estimate of the pixel (Lightcuts' Weber-law criterion, Walter et al. 2005 §4; ε = 2 % in
+//! estimate of the pixel (Lightcuts' Weber-law criterion, Walter et al. 2005; ε = 2 % in
 //! both papers). A pair of one gather point and one VPL is evaluated exactly and has bound 0;
 //! a pair whose clusters face away from each other has B = 0 and is exactly 0. Children that
-//! keep both representatives of their parent reuse its H (MDLC §4: the representative is
+//! keep both representatives of their parent reuse its H (as in MDLC: the representative is
 //! one of a child's).
 //!
 //! # What it estimates, and its bias

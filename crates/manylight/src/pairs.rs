@@ -1,5 +1,5 @@
 //! What the two baselines share about a pair (gather cluster, light cluster) of the product
-//! graph of Multidimensional Lightcuts (Walter et al. 2006 §3): the light transport H(y, x) of
+//! graph of Multidimensional Lightcuts (Walter et al. 2006): the light transport H(y, x) of
 //! one (VPL, gather point) pair, its upper bound over two clusters, and the Max-Extent choice of
 //! the cluster to refine.
 //!
