@@ -180,7 +180,9 @@ impl Settings {
 pub enum Status {
     /// ΔI < εI.
     Converged,
-    /// Every live triplet has bound M_j = 0: the value is exactly 0.
+    /// Every live triplet has error bound 0, so the value is exact: 0 for the many-light
+    /// estimator (bounds M_j = 0); for the baselines also the exact sum over their point set
+    /// (every pair a single gather point and a single VPL, [`crate::mdlc`], [`crate::eelc`]).
     Exact,
     /// All samples were 0 after `min_triplets` triplets (declared 0).
     Zero,
@@ -197,13 +199,13 @@ pub struct PixelEstimate {
     pub rgb: [f64; 3],
     /// Î of the scalar (luminance) that is error-controlled.
     pub value: f64,
-    /// ΔI at the end (0 when J is 0).
+    /// ΔI at the end (0 when J is 0). For MDLC ([`crate::mdlc`]), the sum of the cut's error
+    /// bounds instead (a deterministic bound, not an interval).
     pub delta: f64,
+    /// The standard error of `value`, ΔI / t_α(ν) (0 when J is 0, and for MDLC).
+    pub std_error: f64,
     /// Triplets J at the end.
     pub triplets: usize,
-    /// Of those, the triplets with a bound M_j > 0 (the sampled strata): the degrees of freedom
-    /// ν of ΔI's Student-t quantile.
-    pub sampled: usize,
     /// Triangle splits made.
     pub splits: usize,
     /// Splits refused by the cap.
@@ -218,6 +220,27 @@ pub struct PixelEstimate {
     pub samples: u64,
     /// Why it stopped.
     pub status: Status,
+}
+
+impl PixelEstimate {
+    /// The estimate of a pixel with nothing to estimate (e.g. no gather point of non-zero
+    /// strength): exactly 0, no work.
+    pub fn zero() -> PixelEstimate {
+        PixelEstimate {
+            rgb: [0.0; 3],
+            value: 0.0,
+            delta: 0.0,
+            std_error: 0.0,
+            triplets: 0,
+            splits: 0,
+            split_cap_hits: 0,
+            frozen: 0,
+            zero_variance: 0,
+            g_clamped: 0,
+            samples: 0,
+            status: Status::Exact,
+        }
+    }
 }
 
 /// Everything shared by all pixels of one translucent object: the light tree, the mesh BVH,
@@ -246,10 +269,11 @@ struct Triplet {
     live: bool,
 }
 
+/// A heap entry: a triplet's (or pair's) error bound and its index in the pixel's list.
 #[derive(Clone, Copy, Debug)]
-struct Item {
-    e: f64,
-    idx: u32,
+pub(crate) struct Item {
+    pub(crate) e: f64,
+    pub(crate) idx: u32,
 }
 
 impl PartialEq for Item {
@@ -272,10 +296,10 @@ impl Ord for Item {
 
 /// A SplitMix64 stream (Steele, Lea & Flood 2014) seeded per pixel: the state advances by the
 /// golden gamma and each output is `sss_util::splitmix64` of the state.
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
-    fn next_f64(&mut self) -> f64 {
+    pub(crate) fn next_f64(&mut self) -> f64 {
         let x = sss_util::splitmix64(self.0);
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
@@ -451,6 +475,7 @@ impl<'a> Estimator<'a> {
             }
         };
         let sums = exact_sums(&triplets);
+        let delta = self.delta(sums.bounded, sums.s2);
         let zero_variance = triplets
             .iter()
             .filter(|t| t.live && t.m > 0.0 && t.s2 == 0.0)
@@ -458,9 +483,13 @@ impl<'a> Estimator<'a> {
         PixelEstimate {
             rgb: sums.rgb,
             value: sums.value,
-            delta: self.delta(sums.bounded, sums.s2),
+            delta,
+            std_error: if sums.bounded > 0 {
+                delta / self.t.quantile(sums.bounded)
+            } else {
+                0.0
+            },
             triplets: sums.live,
-            sampled: sums.bounded,
             splits: refs.splits(),
             split_cap_hits: refs.cap_hits(),
             frozen,

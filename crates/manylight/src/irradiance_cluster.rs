@@ -202,6 +202,21 @@ impl IrradianceTree {
     pub fn area(&self) -> f64 {
         self.nodes[0].area
     }
+
+    /// A point uniformly distributed by area over the whole mesh (density 1/A, Eq. 7 at the
+    /// root) from three uniforms in [0, 1): a triangle in proportion to its area, then a uniform
+    /// point on it. Returns the point and the triangle's normal.
+    pub fn sample_uniform(&self, u: [f64; 3]) -> (DVec3, DVec3) {
+        let nodes = &self.nodes;
+        let (leaf, _) = descend(
+            0,
+            u[0],
+            |k| nodes[k as usize].children,
+            |k| nodes[k as usize].area,
+        );
+        let tri = &self.triangles[nodes[leaf as usize].triangle as usize];
+        (tri.sample(u[1], u[2]), tri.normal)
+    }
 }
 
 /// One triangle of a [`Refinements`] arena.

@@ -28,6 +28,17 @@
 //! * [`profile`]: the checked R_d(r) and F_t(cos θ) closures.
 //! * [`summary`]: frame-level counts (pixels at each cap or hazard).
 //!
+//! The two baselines of the paper's §5 share the VPLs and the light tree but work on a FIXED
+//! set of N irradiance points per shading point (BSSRDF importance-sampled by the renderer, or
+//! uniform by area, [`gather_tree::uniform_points`]):
+//!
+//! * [`gather_tree`]: gather points (an irradiance point carrying w(x_o) A_k R_d of its shading
+//!   point) and the per-pixel gather tree.
+//! * [`mdlc`]: Multidimensional Lightcuts (Walter et al. 2006) with BSSRDF importance sampling
+//!   (Walter et al. 2012): the representative cut under the Weber criterion.
+//! * [`eelc`]: the error estimation for Lightcuts (Sakai et al. 2019): stratified sampling of
+//!   the same product graph with the Student-t interval of the estimator.
+//!
 //! **Units.** One length unit throughout (positions, `g_max` in 1/length², R_d in
 //! 1/length², areas in length²); intensities in W/sr; the result is in the units of
 //! `w · R_d · I · G · A`, i.e. radiance when the weights carry 1/π and the exit Fresnel factor.
@@ -75,8 +86,12 @@ mod binary_tree;
 pub mod bounds;
 pub mod cone;
 pub mod confidence;
+pub mod eelc;
 pub mod estimator;
+pub mod gather_tree;
 pub mod irradiance_cluster;
+pub mod mdlc;
+mod pairs;
 pub mod profile;
 pub mod shading_cluster;
 pub mod summary;
@@ -85,8 +100,13 @@ pub mod vpl;
 pub use aabb::{Aabb, Sphere};
 pub use bounds::{ClusterKind, Selection};
 pub use confidence::StudentT;
+pub use eelc::{Eelc, EelcSettings};
 pub use estimator::{Estimator, Interval, PixelEstimate, Settings, Status, Visibility, pixel_seed};
+pub use gather_tree::{
+    GatherNode, GatherPoint, GatherTree, IrradiancePoint, gather_points, uniform_points,
+};
 pub use irradiance_cluster::{IcId, IrradianceTree, Refinements, Triangle};
+pub use mdlc::{CutPair, Mdlc, MdlcSettings};
 pub use profile::{LUMINANCE, RadialProfile, Transmittance, luminance};
 pub use shading_cluster::{ShadingPoint, ShadingTree};
 pub use summary::Summary;
@@ -123,5 +143,8 @@ mod send_sync {
         assert_send_sync::<crate::Transmittance>();
         assert_send_sync::<crate::StudentT>();
         assert_send_sync::<crate::Estimator<'static>>();
+        assert_send_sync::<crate::Mdlc<'static>>();
+        assert_send_sync::<crate::Eelc<'static>>();
+        assert_send_sync::<crate::GatherTree>();
     }
 }

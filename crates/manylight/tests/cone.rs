@@ -246,7 +246,7 @@ fn faces_turned_away_from_the_light_are_exact_zeros() {
             }
         }
     }
-    let se = px.delta / t.quantile(px.sampled);
+    let se = px.std_error;
     assert!(
         (px.value - sum).abs() < 4.0 * se + 1e-3 * sum,
         "estimate {} ± {se} vs brute force {sum}",

@@ -229,6 +229,34 @@ pub fn check_irradiance_with(
     Ok(())
 }
 
+/// Fails, naming the method, the bytes and the budget, when the frame of `scene` and the
+/// `structures` bytes a method without irradiance samples declares
+/// ([`crate::integrators::Integrator::structure_bytes`]: VPLs, per-thread point sets and cuts at
+/// their caps) need more than `budget` bytes.
+pub fn check_structures(
+    scene: &Scene,
+    method: &str,
+    structures: u64,
+    budget: u64,
+) -> Result<(), Error> {
+    let cam = &scene.camera;
+    let frame = frame_bytes(cam.width, cam.height, cam.pixel_samples);
+    let needed = frame.saturating_add(structures);
+    if needed > budget {
+        return Err(Error::Input(format!(
+            "scene {}: method {method}'s structures (lights, and per thread its per-pixel \
+             points and cut at their caps) need about {structures} bytes ({}) on top of the \
+             frame's {frame} bytes, over the memory budget of {budget} bytes ({}); lower the \
+             method's caps (e.g. --irradiance-points, --max-pairs, --max-triplets, \
+             --max-splits, --vpls), use fewer threads, or raise --max-memory",
+            scene.name,
+            human(structures),
+            human(budget)
+        )));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

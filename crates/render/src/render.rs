@@ -92,7 +92,8 @@ impl RenderOutput {
 
 /// Renders `scene` with `integrator`. `progress` counts shaded G-buffer samples. Fails before
 /// allocating when the scene breaks the invariants of its types ([`check_scene`]) or the frame
-/// would not fit `settings.max_memory`, and when the integrator fails (e.g. a kernel cannot be
+/// with the method's irradiance samples and structures ([`Integrator::structure_bytes`]) would
+/// not fit `settings.max_memory`, and when the integrator fails (e.g. a kernel cannot be
 /// built, or a method needs a radial model).
 pub fn render(
     scene: &Scene,
@@ -107,6 +108,13 @@ pub fn render(
             scene,
             &irradiance,
             |est| integrator.structure_bytes(scene, est),
+            settings.max_memory,
+        )?;
+    } else {
+        crate::budget::check_structures(
+            scene,
+            integrator.name(),
+            integrator.structure_bytes(scene, &[]),
             settings.max_memory,
         )?;
     }

@@ -23,6 +23,9 @@ pub enum Stream {
     Vpl = 6,
     /// Light paths traced for one-bounce VPLs (per light).
     Bounce = 7,
+    /// The fixed irradiance points of the many-light baselines (`mdlc`, `eelc`; per pixel
+    /// sample).
+    IrradiancePoints = 8,
 }
 
 /// The generator for work item `index` of `stream` under `seed`.

@@ -58,6 +58,7 @@ fn cheap(name: &str) -> MethodOptions {
         "exact" => MethodOptions::new().with("spacing", 2.0),
         "pathtrace" => MethodOptions::new().with("spp", 2),
         "single-tree" | "dual-tree" => MethodOptions::new().with("spacing", 2.0),
+        "mdlc" | "eelc" => MethodOptions::new().with("irradiance-points", 32),
         _ => MethodOptions::new(),
     }
 }
@@ -368,5 +369,8 @@ fn registry_defaults_match_the_settings_types() {
     assert_eq!(Exact::from_options(&d).unwrap(), Exact::default());
     assert_eq!(PathTrace::from_options(&d).unwrap(), PathTrace::default());
     assert_eq!(Separable::from_options(&d).unwrap(), Separable::default());
+    use sss_render::integrators::{eelc::Eelc, mdlc::Mdlc};
+    assert_eq!(Mdlc::from_options(&d).unwrap(), Mdlc::default());
+    assert_eq!(Eelc::from_options(&d).unwrap(), Eelc::default());
     let _: &dyn Integrator = &Exact::default();
 }

@@ -480,3 +480,249 @@ fn bounce_vpls_carry_the_reflected_power() {
     assert!(sum(&o1) > 1.02 * sum(&o0), "{} vs {}", sum(&o1), sum(&o0));
     assert!(m1.describe().contains("one bounce"));
 }
+
+// ---------------------------------------------------------------------------------------------
+// The baselines `mdlc` and `eelc` (same VPLs, light tree, weights and G clamp as `manylight`).
+// ---------------------------------------------------------------------------------------------
+
+/// The relative difference Σ(b − m)/Σm of the luminances over the pixels where m > 0, and its
+/// standard error √n · sd(b − m)/Σm (pixels are independent: each has its own irradiance
+/// points), and the pixel count.
+fn relative_difference(b: &[[f64; 3]], m: &[[f64; 3]]) -> (f64, f64, usize) {
+    let (d, sm): (Vec<f64>, Vec<f64>) = b
+        .iter()
+        .zip(m)
+        .filter(|(_, m)| lum(**m) > 0.0)
+        .map(|(b, m)| (lum(*b) - lum(*m), lum(*m)))
+        .unzip();
+    let n = d.len() as f64;
+    let total: f64 = sm.iter().sum();
+    let mean = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
+    (mean * n / total, var.sqrt() * n.sqrt() / total, d.len())
+}
+
+/// MDLC and EELC estimate the pixel value `manylight` estimates: over the translucent pixels of
+/// a small sphere (2 samples per pixel), the relative difference of the summed luminance from
+/// `manylight` at ε = 0.5 % is within 4 of its standard errors (the baselines' point sets are
+/// independent per pixel) plus 0.5 % (manylight's own error, and MDLC's bias at ε = 1 %), with uniform points on
+/// a material made wide enough for 2048 uniform points to find it (units_per_mm 0.5: red
+/// diffuses 1.9 units over a unit sphere) and with importance-sampled points on the scene's own
+/// skin. The standard errors are small enough for the test to see a 2 % bias.
+#[test]
+fn baselines_agree_with_manylight_within_statistical_error() {
+    let settings = RenderSettings::default();
+    let base = {
+        let mut s = scene("sphere", 24, 18);
+        s.camera.pixel_samples = 2;
+        s
+    };
+    let mut wide = base.clone();
+    for m in &mut wide.materials {
+        if let sss_scene::MaterialKind::Translucent(t) = &mut m.kind {
+            t.units_per_mm = 0.5;
+        }
+    }
+    for (s, points, uniform) in [(&wide, 2048, true), (&base, 1024, false)] {
+        let ml = integrators::build("manylight", &MethodOptions::new().with("eps", 0.005)).unwrap();
+        let reference = render(s, ml.as_ref(), &settings, &NoProgress).unwrap();
+        for (method, eps) in [("mdlc", 0.01), ("eelc", 0.02)] {
+            let mut o = MethodOptions::new()
+                .with("eps", eps)
+                .with("irradiance-points", points);
+            if uniform {
+                o = o.with("uniform-points", "");
+            }
+            let m = integrators::build(method, &o).unwrap();
+            let out = render(s, m.as_ref(), &settings, &NoProgress).unwrap();
+            let (mean, se, n) = relative_difference(&out.subsurface, &reference.subsurface);
+            eprintln!("{method} uniform={uniform}: {n} pixels, rel. diff {mean:.4} ± {se:.4}");
+            assert!(n > 80, "{n} lit pixels");
+            assert!(
+                mean.abs() < 4.0 * se + 5e-3,
+                "{method} uniform={uniform}: relative difference {mean} (se {se})"
+            );
+            assert!(
+                se < 5e-3,
+                "{method} uniform={uniform}: se {se} too large to see a bias"
+            );
+            let stat = |n: &str| out.stats.iter().find(|s| s.name == n).unwrap().value;
+            assert_eq!(stat("irradiance_points"), points as f64);
+            assert_eq!(stat("pixels_pair_cap"), 0.0);
+            assert!(out.layer("pairs").unwrap().iter().any(|p| p[0] > 1.0));
+        }
+    }
+}
+
+/// Shadowed and black pixels terminate: on the slab (a wall's shadow over half of it, one
+/// directional light), every pixel estimate ends without the pair cap, finite and ≥ 0; pixels
+/// deep in the shadow are exactly 0 for MDLC (every pair refined to one point and the light) or
+/// stop early for EELC. The pair cap holds. With the light's power set to 0 every pixel is
+/// exactly 0 at once.
+#[test]
+fn baselines_terminate_on_shadowed_and_black_pixels() {
+    let s = scene("slab", 32, 24);
+    let mut black = s.clone();
+    for l in &mut black.lights {
+        if let Light::Directional { irradiance, .. } = l {
+            *irradiance = [0.0; 3];
+        }
+    }
+    let settings = RenderSettings::default();
+    for method in ["mdlc", "eelc"] {
+        for uniform in [false, true] {
+            let mut o = MethodOptions::new().with("irradiance-points", 64);
+            if uniform {
+                o = o.with("uniform-points", "");
+            }
+            let m = integrators::build(method, &o).unwrap();
+            let out = render(&s, m.as_ref(), &settings, &NoProgress).unwrap();
+            let stat = |n: &str| out.stats.iter().find(|s| s.name == n).unwrap().value;
+            assert!(stat("pixel_estimates") > 100.0);
+            assert_eq!(stat("pixels_pair_cap"), 0.0, "{method}");
+            assert!(
+                out.subsurface
+                    .iter()
+                    .flatten()
+                    .all(|v| v.is_finite() && *v >= 0.0)
+            );
+            let pairs = out.layer("pairs").unwrap();
+            // At most 64 points × 1 light pairs in any pixel.
+            assert!(pairs.iter().all(|p| p[0] <= 64.0), "{method}");
+            assert!(
+                out.subsurface.iter().any(|v| lum(*v) > 0.0),
+                "{method}: the lit part is lit"
+            );
+            // The pair cap holds, is counted and warned about (ε = 0 never converges).
+            let capped =
+                integrators::build(method, &o.clone().with("eps", 0).with("max-pairs", 5)).unwrap();
+            let c = render(&s, capped.as_ref(), &settings, &NoProgress).unwrap();
+            let cstat = |n: &str| c.stats.iter().find(|s| s.name == n).unwrap().value;
+            assert!(c.layer("pairs").unwrap().iter().all(|p| p[0] <= 5.0));
+            assert!(
+                cstat("pixels_pair_cap") > 0.5 * cstat("pixel_estimates"),
+                "{method}"
+            );
+            assert!(
+                c.warnings.iter().any(|w| w.contains("pair cap")),
+                "{:?}",
+                c.warnings
+            );
+            let dark = render(&black, m.as_ref(), &settings, &NoProgress).unwrap();
+            let stat = |n: &str| dark.stats.iter().find(|s| s.name == n).unwrap().value;
+            assert_eq!(stat("vpls"), 0.0);
+            assert!(dark.subsurface.iter().all(|v| *v == [0.0; 3]));
+        }
+    }
+}
+
+/// The same bits for 1 and 2 threads, with importance-sampled and uniform points.
+#[test]
+fn baselines_are_bit_identical_across_thread_counts() {
+    let s = scene("sphere", 20, 15);
+    for method in ["mdlc", "eelc"] {
+        for uniform in [false, true] {
+            let mut o = MethodOptions::new().with("irradiance-points", 128);
+            if uniform {
+                o = o.with("uniform-points", "");
+            }
+            let m = integrators::build(method, &o).unwrap();
+            let run = |threads| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| render(&s, m.as_ref(), &RenderSettings::default(), &NoProgress))
+                    .unwrap()
+            };
+            let (a, b) = (run(1), run(2));
+            let bits =
+                |v: &[[f64; 3]]| -> Vec<u64> { v.iter().flatten().map(|x| x.to_bits()).collect() };
+            assert_eq!(
+                bits(&a.subsurface),
+                bits(&b.subsurface),
+                "{method} uniform={uniform}"
+            );
+            assert_eq!(a.std_error, b.std_error);
+            assert_eq!(a.layers, b.layers);
+            assert!(a.subsurface.iter().any(|v| lum(*v) > 0.0));
+        }
+    }
+}
+
+#[test]
+fn baselines_refuse_bad_options_unsupported_models_and_textures() {
+    for method in ["mdlc", "eelc"] {
+        for (k, v) in [
+            ("eps", "-1"),
+            ("irradiance-points", "0"),
+            ("irradiance-points", "2000000"),
+            ("irradiance-points", "many"),
+            ("max-pairs", "0"),
+            ("vpls", "0"),
+        ] {
+            let e = integrators::build(method, &MethodOptions::new().with(k, v))
+                .err()
+                .unwrap_or_else(|| panic!("{method} --{k} {v} accepted"))
+                .to_string();
+            assert!(e.contains(&format!("--{k}")), "{e}");
+        }
+        // Options of other methods are named as such.
+        let e = integrators::build(method, &MethodOptions::new().with("selection", "bssrdf"))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("--selection") && e.contains(method), "{e}");
+        // The directional dipole: the same refusal as manylight, naming the material.
+        let m =
+            integrators::build(method, &MethodOptions::new().with("irradiance-points", 4)).unwrap();
+        let e = render(
+            &scene("picnic", 16, 12),
+            m.as_ref(),
+            &RenderSettings::default(),
+            &NoProgress,
+        )
+        .unwrap_err();
+        assert!(matches!(e, sss_render::Error::Unsupported(_)), "{e}");
+        let e = e.to_string();
+        assert!(e.contains("`apple`") && e.contains("directional"), "{e}");
+        // A pre-scatter texture on a radial model.
+        let mut toad = scene("toad", 16, 12);
+        for mat in &mut toad.materials {
+            if let sss_scene::MaterialKind::Translucent(t) = &mut mat.kind {
+                t.model = sss_bssrdf::ModelKind::BetterDipole;
+            }
+        }
+        let e = render(&toad, m.as_ref(), &RenderSettings::default(), &NoProgress)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("pre-scatter textures") && e.contains(method),
+            "{e}"
+        );
+        // Memory: a million points per shading point do not fit 64 MiB; the error says which
+        // method and which options to lower.
+        let big = integrators::build(
+            method,
+            &MethodOptions::new().with("irradiance-points", 1 << 20),
+        )
+        .unwrap();
+        let tight = RenderSettings {
+            max_memory: 64 << 20,
+            ..RenderSettings::default()
+        };
+        let e = render(&scene("sphere", 16, 12), big.as_ref(), &tight, &NoProgress)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(method) && e.contains("--irradiance-points"),
+            "{e}"
+        );
+    }
+    // eelc's confidence level.
+    let e = integrators::build("eelc", &MethodOptions::new().with("alpha", "1"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("--alpha"), "{e}");
+}

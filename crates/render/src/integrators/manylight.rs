@@ -245,11 +245,11 @@ pub const PROFILE_TOLERANCE: f64 = 5e-2;
 /// there. 64 triplets (128 samples over a cluster cut ≥ 64 ways) make that unlikely.
 pub const MIN_TRIPLETS: usize = 64;
 
-/// What the estimator needs of one translucent object.
-struct ObjectData {
-    tree: IrradianceTree,
-    profile: RadialProfile,
-    ft: Transmittance,
+/// What the estimator needs of one translucent object (shared with the baselines).
+pub(crate) struct ObjectData {
+    pub(crate) tree: IrradianceTree,
+    pub(crate) profile: RadialProfile,
+    pub(crate) ft: Transmittance,
 }
 
 /// One pixel's output.
@@ -261,17 +261,17 @@ struct PixelOut {
     summary: Summary,
 }
 
-/// The estimator's error as this crate's input error, naming the object and material.
-fn model_error(scene: &Scene, o: u32, e: sss_manylight::Error) -> Error {
+/// The estimator's error as this crate's input error, naming the object, material and method.
+pub(crate) fn model_error(scene: &Scene, o: u32, method: &str, e: sss_manylight::Error) -> Error {
     let obj = &scene.objects[o as usize];
     Error::Input(format!(
-        "object `{}` (material `{}`): manylight: {e}",
+        "object `{}` (material `{}`): {method}: {e}",
         obj.name, scene.materials[obj.material].name
     ))
 }
 
-/// The geometry's box centre and half-diagonal over every object.
-fn scene_box(frame: &Frame<'_>) -> (DVec3, f64) {
+/// The geometry's box centre and half-diagonal over every object (shared with the baselines).
+pub(crate) fn scene_box(frame: &Frame<'_>) -> (DVec3, f64) {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     for o in 0..frame.scene.objects.len() as u32 {
@@ -314,8 +314,12 @@ pub(crate) fn light_tree_seeded(
         .map_err(|e| Error::Input(format!("manylight VPLs: {e}")))
 }
 
-/// The per-object data of every visible translucent object (indexed by object).
-fn object_data(frame: &Frame<'_>, method: &str) -> Result<Vec<Option<ObjectData>>, Error> {
+/// The per-object data of every visible translucent object (indexed by object; shared with
+/// the baselines).
+pub(crate) fn object_data(
+    frame: &Frame<'_>,
+    method: &str,
+) -> Result<Vec<Option<ObjectData>>, Error> {
     let scene = frame.scene;
     let mut out: Vec<Option<ObjectData>> = (0..scene.objects.len()).map(|_| None).collect();
     for &o in &frame.visible {
@@ -336,7 +340,7 @@ fn object_data(frame: &Frame<'_>, method: &str) -> Result<Vec<Option<ObjectData>
         };
         let mesh = &scene.objects[o as usize].mesh;
         let tree = IrradianceTree::new(&mesh.positions, &mesh.triangles)
-            .map_err(|e| model_error(scene, o, e))?;
+            .map_err(|e| model_error(scene, o, method, e))?;
         // R_d in scene units as `rd_scene` computes it: R_d(r/u)/u², u = units per mm. The
         // profile must own its model, so the material's model is built again here.
         let model: std::sync::Arc<dyn sss_bssrdf::Bssrdf> = make_model(t.model, &t.medium).into();
@@ -356,11 +360,11 @@ fn object_data(frame: &Frame<'_>, method: &str) -> Result<Vec<Option<ObjectData>
         let profile = match RadialProfile::new(rd.clone(), r_scale) {
             Ok(p) => p,
             Err(_) => RadialProfile::with_tolerance(rd, r_scale, PROFILE_TOLERANCE)
-                .map_err(|e| model_error(scene, o, e))?,
+                .map_err(|e| model_error(scene, o, method, e))?,
         };
         let eta = sh.eta;
         let ft = Transmittance::new(move |c| ft_dielectric(c, eta))
-            .map_err(|e| model_error(scene, o, e))?;
+            .map_err(|e| model_error(scene, o, method, e))?;
         out[o as usize] = Some(ObjectData { tree, profile, ft });
     }
     Ok(out)
@@ -414,7 +418,7 @@ impl ManyLight {
                     d.as_ref()
                         .map(|d| {
                             Estimator::new(lt, &d.tree, &d.profile, &d.ft, &t, settings)
-                                .map_err(|e| model_error(scene, o as u32, e))
+                                .map_err(|e| model_error(scene, o as u32, METHOD.name, e))
                         })
                         .transpose()
                 })
@@ -478,7 +482,8 @@ impl ManyLight {
                 if !(e_sum > 0.0) {
                     continue;
                 }
-                let tree = ShadingTree::new(points).map_err(|e| model_error(scene, o, e))?;
+                let tree =
+                    ShadingTree::new(points).map_err(|e| model_error(scene, o, METHOD.name, e))?;
                 let mut object_seed = frame.seed ^ sss_util::splitmix64(u64::from(o));
                 if self.stream != 0 {
                     object_seed ^= sss_util::splitmix64(self.stream ^ 0x5354_5245_414d);
@@ -494,8 +499,8 @@ impl ManyLight {
                 }
                 // The standard error of the luminance, ΔI / t_α(J), given to each
                 // channel in proportion to its value.
-                if px.sampled > 0 && px.value > 0.0 {
-                    let se = px.delta / t.quantile(px.sampled);
+                if px.std_error > 0.0 && px.value > 0.0 {
+                    let se = px.std_error;
                     for c in 0..3 {
                         let s = px.rgb[c].max(0.0) * se / px.value;
                         var[c] += s * s;

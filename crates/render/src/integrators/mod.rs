@@ -21,9 +21,12 @@
 //! entry (name, options, constructor, compare sweep), and one line in [`METHODS`]. The `sss
 //! render` flags, the `cargo xtask compare` sweep and the pipeline all read the registry.
 
+pub mod baseline;
 pub mod dual_tree;
+pub mod eelc;
 pub mod exact;
 pub mod manylight;
+pub mod mdlc;
 pub mod options;
 pub mod pathtrace;
 pub mod separable;
@@ -133,6 +136,8 @@ pub const METHODS: &[Method] = &[
     single_tree::METHOD,
     dual_tree::METHOD,
     manylight::METHOD,
+    mdlc::METHOD,
+    eelc::METHOD,
 ];
 
 /// The registry entry named `name`.

@@ -241,15 +241,20 @@ impl Sampler<'_> {
         pdf
     }
 
-    /// One path-traced estimate of the subsurface radiance leaving `g` (0 when the probe finds no
-    /// point; such samples still count).
-    pub fn sample(&self, g: &GSample, rng: &mut Pcg64Mcg, scratch: &mut Scratch) -> Rgb {
-        let (geom, lights, shading, radii) = (self.geom, self.lights, self.shading, self.radii);
-        let Scratch {
-            hits,
-            chord,
-            packets,
-        } = scratch;
+    /// One BSSRDF importance-sampled point on `g`'s object around `g` (King et al. 2013, pbrt
+    /// 3rd ed. §15.4: an axis and a channel, a radius from that channel's profile, one of the
+    /// probe chord's hits chosen uniformly) and its combined density per unit area over the
+    /// nine axis-channel techniques (finite, > 0); `None` when the probe finds no point (such
+    /// draws still count in an average). The irradiance points of the `mdlc` and `eelc`
+    /// baselines are drawn here.
+    pub fn sample_point(
+        &self,
+        g: &GSample,
+        rng: &mut Pcg64Mcg,
+        scratch: &mut Scratch,
+    ) -> Option<(SurfaceHit, f64)> {
+        let (geom, shading, radii) = (self.geom, self.shading, self.radii);
+        let Scratch { hits, chord, .. } = scratch;
         let ax = axes(g.n);
         // Choose axis and channel.
         let u1: f64 = rng.random();
@@ -264,12 +269,12 @@ impl Sampler<'_> {
         let ch = rng.random_range(0..3usize);
         let rmax = radii.rmax[ch];
         if !(rmax > 0.0) {
-            return [0.0; 3];
+            return None;
         }
         let u = shading.units_per_mm;
         let r = shading.bssrdf().sample_sr(ch, rng.random::<f64>()) * u;
         if !(r.is_finite() && r >= 0.0) || r > rmax {
-            return [0.0; 3];
+            return None;
         }
         let phi = 2.0 * PI * rng.random::<f64>();
         let rmax_all = radii.rmax.iter().copied().fold(0.0, f64::max);
@@ -283,7 +288,7 @@ impl Sampler<'_> {
             .filter(|&k| (hits[k].0 - half_all).abs() <= half)
             .collect();
         if mine.is_empty() {
-            return [0.0; 3];
+            return None;
         }
         let pick = mine[rng.random_range(0..mine.len())];
         let pi = hits[pick].1;
@@ -294,8 +299,20 @@ impl Sampler<'_> {
         };
         let pdf = self.combined_pdf(g.object, g.p, &ax, &pi, known, chord);
         if !(pdf > 0.0) || !pdf.is_finite() {
-            return [0.0; 3];
+            return None;
         }
+        Some((pi, pdf))
+    }
+
+    /// One path-traced estimate of the subsurface radiance leaving `g` (0 when the probe finds no
+    /// point; such samples still count).
+    pub fn sample(&self, g: &GSample, rng: &mut Pcg64Mcg, scratch: &mut Scratch) -> Rgb {
+        let (geom, lights, shading) = (self.geom, self.lights, self.shading);
+        let Some((pi, pdf)) = self.sample_point(g, rng, scratch) else {
+            return [0.0; 3];
+        };
+        let packets = &mut scratch.packets;
+        let u = shading.units_per_mm;
         // Direct light at the exit point.
         packets.clear();
         let at = Receiver {
