@@ -154,8 +154,8 @@ file = "happy-buddha-100k.obj"
 transform = { translate = [0.55, 0.0, 0.0] }
 "#;
 
-/// The Lee Perry-Smith head scan (0.45 units wide in the file) ×10, in skin1 at 200 mm wide
-/// at the shoulders' scale of the file, lit from the front left.
+/// The Lee Perry-Smith head scan (0.45 units wide in the file, about metres) ×10, in skin1 at
+/// 0.01 units per mm (true size), lit from the front left by a quad facing it (−z).
 pub const HEAD: &str = r#"# Head, `cargo xtask compare --manylight`.
 [camera]
 position = [0.0, -0.4, 7.0]
@@ -167,8 +167,8 @@ pixel_samples = 16
 [[lights]]
 type = "quad"
 corner = [-3.0, 1.5, 2.5]
-edge_u = [1.5, 0.0, 0.0]
-edge_v = [0.0, 1.5, 0.0]
+edge_u = [0.0, 1.5, 0.0]
+edge_v = [1.5, 0.0, 0.0]
 radiance = 30.0
 
 [materials.skin]
