@@ -939,8 +939,13 @@ pub fn tail_masses(edges: &[f64], mass: &[f64], se: &[f64]) -> (Vec<f64>, usize)
             .partition_point(|p| centre(p) <= x)
             .clamp(1, points.len() - 1);
         let (a, b) = (&points[j - 1], &points[j]);
-        let t = (x - centre(a)) / (centre(b) - centre(a));
-        (1.0 - t) * a.density.ln() + t * b.density.ln()
+        let slope = (b.density.ln() - a.density.ln()) / (centre(b) - centre(a));
+        if x > centre(b) {
+            // Beyond the last point the density may only fall (a noisy last group must not
+            // pile its mass up at its far end).
+            return b.density.ln() + slope.min(0.0) * (x - centre(b));
+        }
+        a.density.ln() + slope * (x - centre(a))
     };
     for g in &groups {
         let target: f64 = mass[g.clone()].iter().sum();
@@ -1072,18 +1077,36 @@ pub fn non_increasing_fit(y: &[f64], w: &[f64]) -> Vec<f64> {
 /// 1. the narrow bins near the origin are pooled by [`inner_masses`], and the tail beyond the
 ///    resolved bins is regularised by [`tail_masses`] (pooled groups, the unresolved rest
 ///    spread like the fitted exponential);
-/// 2. the histopolation system gives the knot values whose spline integrates to every bin;
-/// 3. negative values are set to 0, and R_d = T/(2πx) at the knots is made non-increasing by
-///    weighted isotonic regression (weights: the inverse variance of each bin's tally), which
-///    changes nothing where the tallies are already ordered beyond their noise and pools
-///    neighbours where noise reverses them.
+/// 2. the bins' R_d averages over their annuli are made non-increasing by isotonic regression
+///    with the annuli's areas as weights (mass-conserving: pooled bins share their tallied
+///    light), which changes nothing where the tallies are ordered and pools neighbours where
+///    noise reverses them;
+/// 3. the histopolation system gives the knot values whose spline integrates to every bin;
+/// 4. negative values are set to 0, and R_d = T/(2πx) at the knots is made non-increasing by
+///    isotonic regression weighted by the light each knot carries (a knot value can overshoot
+///    its neighbour a little even when the bin averages are ordered).
 pub fn row_nodes(system: &Histopolation, knots: &[f64], mass: &[f64], se: &[f64]) -> Vec<f64> {
     let xs = spline_knots(knots);
     let n = xs.len();
     let edges = tally_edges(knots);
     let inner = inner_masses(&edges, mass, se);
-    let (masses, last) = tail_masses(&edges, &inner, se);
+    let (tail, _) = tail_masses(&edges, &inner, se);
+    // R_d averaged over each bin's annulus, made non-increasing with the annuli's areas as
+    // weights: pooled bins share their total mass, so no light is gained or lost.
+    let areas: Vec<f64> = edges
+        .windows(2)
+        .map(|e| PI * (e[1] * e[1] - e[0] * e[0]))
+        .collect();
+    let averages: Vec<f64> = tail.iter().zip(&areas).map(|(m, a)| m / a).collect();
+    let masses: Vec<f64> = non_increasing_fit(&averages, &areas)
+        .iter()
+        .zip(&areas)
+        .map(|(d, a)| d * a)
+        .collect();
     let v = system.solve(&masses);
+    // The spline's own R_d at the knots, made non-increasing too (the bin averages are, but a
+    // knot value can still overshoot its neighbour by a little), weighted by the mass each
+    // knot carries (x times the width of its bin), which keeps the total.
     let mut u = Vec::with_capacity(n - 1);
     let mut w = Vec::with_capacity(n - 1);
     for j in 1..n {
@@ -1094,19 +1117,7 @@ pub fn row_nodes(system: &Histopolation, knots: &[f64], mass: &[f64], se: &[f64]
             0.0
         };
         u.push(value / xs[j]);
-        // The standard error of the knot's bin (bin j − 1: the extra knot shares bin 0 with
-        // nothing else) as a density, over x (R_d's scale); a knot in the regularised tail gets
-        // the relative error of the last resolved bin.
-        let k = j - 1;
-        let width = edges[k + 1] - edges[k];
-        let sd = if k <= last {
-            se[k] / (width * xs[j])
-        } else {
-            let r = last.max(1);
-            let rel = if mass[r] > 0.0 { se[r] / mass[r] } else { 1.0 };
-            rel * value / xs[j]
-        };
-        w.push(1.0 / (sd * sd).max(1e-300));
+        w.push(xs[j] * (edges[j] - edges[j - 1]));
     }
     let fitted = non_increasing_fit(&u, &w);
     let mut out = vec![0.0; n];

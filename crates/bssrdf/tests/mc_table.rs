@@ -269,29 +269,83 @@ fn profiles_are_non_increasing_and_totals_non_decreasing() {
 
 #[test]
 fn table_totals_hold_the_monte_carlo_totals() {
-    // The spline's integral (ρ_eff) against the tallied total reflectance of each row: the
-    // table misses only what escapes beyond its last knot (≈ 960 mean free paths), the first
-    // interval's near-origin tally and what the tail treatment changes.
+    // The spline's integral (ρ_eff) against the tallied total reflectance of each row, from
+    // the same photons: the table misses only what escapes beyond its last knot (≈ 960 mean
+    // free paths) and what the tail treatment and the isotonic fit move. Measured: at most
+    // 0.25 % for albedo ≥ 0.5 (at albedo 1); dropping the unresolved far tail instead of
+    // keeping its tallied mass loses 0.9 % there.
     let data = McTableData::embedded().unwrap();
     let mut worst: (f64, String) = (0.0, String::new());
     for (e, &eta) in ETAS.iter().enumerate() {
         let table = McTable::new(eta);
         for (i, &rho) in data.rho_samples().iter().enumerate() {
-            let (t, se) = data.total(e, i);
             if rho < 0.5 {
                 continue;
             }
+            let inside: f64 = data.mass(e, i).iter().sum();
             let got = table.rho_eff_samples()[i];
-            let rel = ((got - t).abs() - 3.0 * se) / t;
+            let rel = (got - inside).abs() / inside;
             if rel > worst.0 {
-                worst = (rel, format!("eta {eta} rho {rho}: {got} vs {t} ± {se}"));
+                worst = (
+                    rel,
+                    format!(
+                        "eta {eta} rho {rho}: {got} vs {inside} (all radii {})",
+                        data.total(e, i).0
+                    ),
+                );
             }
         }
     }
     println!(
-        "worst total excess over 3 SE: {:.3} % ({})",
+        "worst relative difference: {:.3} % ({})",
         100.0 * worst.0,
         worst.1
     );
-    assert!(worst.0 < 0.005, "{worst:?}");
+    assert!(worst.0 < 0.004, "{worst:?}");
+}
+
+#[test]
+fn splines_integrate_to_the_tallies() {
+    // The knot values are solved so that each row's spline integrates to every tallied bin
+    // (histopolation). Only the pooled near-origin bins, the regularised far tail and the
+    // isotonic fit may move a bin's integral, and only within its noise: over every resolved
+    // bin (relative standard error ≤ 20 %) of every row of every η table, the mean squared
+    // z = (∫_bin spline − tally)/SE stays below 1 (0.23 measured). Knot values taken as bin
+    // averages (no histopolation) give 1.18.
+    let data = McTableData::embedded().unwrap();
+    let edges = tally_edges(data.knots());
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (e, &eta) in ETAS.iter().enumerate() {
+        let table = McTable::new(eta);
+        let xs = table.radius_samples().to_vec();
+        for i in 0..data.rho_samples().len() {
+            let (mass, se) = (data.mass(e, i), data.mass_se(e, i));
+            for k in 0..mass.len() {
+                if !(mass[k] > 0.0 && se[k] > 0.0 && se[k] <= 0.2 * mass[k]) {
+                    continue;
+                }
+                let (lo, hi) = (edges[k], edges[k + 1]);
+                let mut cuts = vec![lo];
+                cuts.extend(xs.iter().copied().filter(|&x| x > lo && x < hi));
+                cuts.push(hi);
+                let integral: f64 = cuts
+                    .windows(2)
+                    .map(|w| {
+                        sss_bssrdf::quadrature::integrate(
+                            &|x| table.row_spline(i, x).unwrap_or(0.0),
+                            w[0],
+                            w[1],
+                            4,
+                        )
+                    })
+                    .sum();
+                let z = (integral - mass[k]) / se[k];
+                sum += z * z;
+                n += 1;
+            }
+        }
+    }
+    let mean = sum / n as f64;
+    println!("{n} resolved bins: mean z² {mean:.3}");
+    assert!(n > 30_000 && mean < 1.0, "{n} bins, mean z² {mean}");
 }
