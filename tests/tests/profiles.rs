@@ -1,18 +1,19 @@
 //! Cross-crate tests: the models of `sss-bssrdf` through the profile and plot code of
 //! `sss-render`.
 
-use sss_bssrdf::monte_carlo::{self, McConfig};
+use sss_bssrdf::monte_carlo::{self, BinSpacing, McConfig};
 use sss_bssrdf::presets::PRESETS;
 use sss_bssrdf::{Medium, ModelKind};
 use sss_cli::profile_table::{MediumSpec, ProfileModel, ProfileRequest, compute};
 use std::path::PathBuf;
 
-const MODELS: [ProfileModel; 5] = [
+const MODELS: [ProfileModel; 6] = [
     ProfileModel::StandardDipole,
     ProfileModel::BetterDipole,
     ProfileModel::DirectionalDipole,
     ProfileModel::Pbd,
     ProfileModel::Burley,
+    ProfileModel::McTable,
 ];
 
 fn request(model: ProfileModel, preset: &str, r_max: f64, steps: usize) -> ProfileRequest {
@@ -81,6 +82,7 @@ fn monte_carlo_table_is_the_library_simulation() {
             r_max: 6.0,
             bins: 12,
             channels: [true; 3],
+            spacing: BinSpacing::Linear,
         },
     )
     .unwrap();
@@ -103,5 +105,30 @@ fn every_model_plots() {
         t.plot(&path, false).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.contains("<svg") && text.contains("green"));
+    }
+}
+
+#[test]
+fn mc_table_refuses_an_eta_outside_its_tables() {
+    // The tables cover η from 1 to 1.5; outside, `sss profile` refuses rather than clamp.
+    for (eta, ok) in [
+        (0.9, false),
+        (1.0, true),
+        (1.45, true),
+        (1.5, true),
+        (1.6, false),
+    ] {
+        let req = ProfileRequest {
+            eta: Some(eta),
+            ..request(ProfileModel::McTable, "skin1", 4.0, 8)
+        };
+        match compute(&req, &|_| {}) {
+            Ok(t) => assert!(ok && t.total[0] > 0.0, "eta {eta}"),
+            Err(e) => {
+                assert!(!ok, "eta {eta}: {e}");
+                let msg = e.to_string();
+                assert!(msg.contains("mc-table") && msg.contains("--eta"), "{msg}");
+            }
+        }
     }
 }

@@ -7,10 +7,13 @@
 //!   (see [`check_results`]).
 //! - `cargo xtask fuzz`: seeded fuzzing of the scene, OBJ and EXR readers and the `sss`
 //!   command line on stable Rust (see [`fuzz`]).
+//! - `cargo xtask tables`: regenerates the `mc-table` model's Monte Carlo table
+//!   (`crates/bssrdf/data/mc_table.bin`, see [`tables`]).
 
 mod check_results;
 mod compare;
 mod fuzz;
+mod tables;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -36,6 +39,27 @@ enum Task {
         /// The compare output directory (holding results.csv).
         dir: PathBuf,
     },
+    /// Regenerate the Monte Carlo table of the `mc-table` model (bit-identical on every run;
+    /// about 700 CPU-seconds, 6 minutes on 2 idle cores).
+    Tables(TablesArgs),
+}
+
+/// Arguments of `cargo xtask tables`.
+#[derive(Debug, clap::Args)]
+struct TablesArgs {
+    /// Output file [default: WORKSPACE/crates/bssrdf/data/mc_table.bin].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Multiply every photon count by this (trial runs; the repository's table uses 1).
+    #[arg(long, default_value_t = 1.0)]
+    scale: f64,
+    /// Regenerate and compare with the output file instead of writing it (fails if they
+    /// differ).
+    #[arg(long)]
+    check: bool,
+    /// Worker threads [default: all cores]; the table is the same for any number.
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 /// Arguments of `cargo xtask fuzz`.
@@ -179,6 +203,31 @@ fn main() -> ExitCode {
     };
     let result = match cli.task {
         Task::Fuzz(args) => return fuzz_main(args),
+        Task::Tables(args) => {
+            let config = tables::Config {
+                out: args
+                    .out
+                    .unwrap_or_else(|| tables::default_path(&workspace_root())),
+                scale: args.scale,
+                check: args.check,
+            };
+            let result = match args.threads {
+                Some(0) => Err("--threads must be at least 1".to_string()),
+                Some(n) => rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map_err(|e| e.to_string())
+                    .and_then(|pool| pool.install(|| tables::run(&config))),
+                None => tables::run(&config),
+            };
+            return match result {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            };
+        }
         Task::CheckResults { dir } => {
             return match check_results::run(&dir) {
                 Ok(n) => {

@@ -2,9 +2,9 @@
 //!
 //! Use this crate when you need the *physics* of translucent materials (skin, marble, milk,
 //! wax) and nothing else: a validated [`Medium`], exact [`fresnel`] terms, five diffusion
-//! models behind one [`Bssrdf`] trait, importance sampling of their radial profiles, and a
-//! Monte Carlo photon random walk ([`monte_carlo`]) that is the ground truth the models are
-//! measured against. It depends on no renderer; everything is `f64`, and every constructor
+//! models and a tabulated Monte Carlo profile ([`mc_table`]) behind one [`Bssrdf`] trait,
+//! importance sampling of their radial profiles, and a Monte Carlo photon random walk
+//! ([`monte_carlo`]) that is the ground truth the models are measured against. It depends on no renderer; everything is `f64`, and every constructor
 //! validates its input and returns a [`BssrdfError`] instead of panicking.
 //!
 //! ```
@@ -43,7 +43,10 @@
 //!   Scattering.* Pixar Technical Memo #15-04, 2015 — normalized diffusion
 //!   ([`ChristensenBurley`]).
 //! - Wang, Jacques, Zheng. *MCML — Monte Carlo modeling of light transport in multi-layered
-//!   tissues.* 1995 — the photon random walk in [`monte_carlo`].
+//!   tissues.* 1995 — the photon random walk in [`monte_carlo`], tabulated over albedo by the
+//!   condensed walk of Graaff et al., *Condensed Monte Carlo simulations for the description
+//!   of light transport*, Appl. Opt. 32(4), 1993 ([`monte_carlo::condensed`]) as the
+//!   `mc-table` model ([`McTableModel`]).
 
 // `!(x > 0.0)` is how this crate rejects NaN along with non-positive values; clippy's
 // suggestion `x <= 0.0` would let NaN through.
@@ -56,6 +59,7 @@ pub mod directional_dipole;
 mod error;
 pub mod fresnel;
 mod inversion;
+pub mod mc_table;
 mod medium;
 pub mod monte_carlo;
 pub mod photon_beam_diffusion;
@@ -74,6 +78,7 @@ pub use directional_dipole::DirectionalDipole;
 pub use error::BssrdfError;
 pub use glam::DVec3;
 pub use inversion::from_reflectance;
+pub use mc_table::McTableModel;
 pub use medium::Medium;
 pub use photon_beam_diffusion::PhotonBeamDiffusion;
 pub use standard_dipole::StandardDipole;
@@ -162,7 +167,7 @@ pub fn fresnel_normalization(eta: f64) -> f64 {
     (1.0 - 2.0 * fresnel::fresnel_moment1(eta)).max(f64::MIN_POSITIVE)
 }
 
-/// The five models, by name.
+/// The models, by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ModelKind {
     /// Jensen et al. 2001.
@@ -175,20 +180,23 @@ pub enum ModelKind {
     PhotonBeamDiffusion,
     /// Christensen & Burley 2015, normalized diffusion.
     Burley,
+    /// The crate's own photon random walk, tabulated ([`mc_table`]).
+    McTable,
 }
 
 impl ModelKind {
     /// Every model, in the order reports list them.
-    pub const ALL: [ModelKind; 5] = [
+    pub const ALL: [ModelKind; 6] = [
         ModelKind::StandardDipole,
         ModelKind::BetterDipole,
         ModelKind::DirectionalDipole,
         ModelKind::PhotonBeamDiffusion,
         ModelKind::Burley,
+        ModelKind::McTable,
     ];
 
     /// The command-line name (`standard-dipole`, `better-dipole`, `directional-dipole`, `pbd`,
-    /// `burley`).
+    /// `burley`, `mc-table`).
     pub fn name(self) -> &'static str {
         match self {
             ModelKind::StandardDipole => "standard-dipole",
@@ -196,6 +204,7 @@ impl ModelKind {
             ModelKind::DirectionalDipole => "directional-dipole",
             ModelKind::PhotonBeamDiffusion => "pbd",
             ModelKind::Burley => "burley",
+            ModelKind::McTable => "mc-table",
         }
     }
 }
@@ -218,7 +227,9 @@ impl FromStr for ModelKind {
 
 /// Builds the model `kind` for `medium`. Photon beam diffusion shares one table per (g, η)
 /// across all media (built on first use, in parallel); normalized diffusion takes its surface
-/// albedo from the table of (0, η) and uses the default fit [`BurleyFit::SearchlightMfp`].
+/// albedo from the table of (0, η) and uses the default fit [`BurleyFit::SearchlightMfp`];
+/// `mc-table` shares one table per η, blended from the embedded Monte Carlo tables (η clamped
+/// to [1, 1.5], g mapped to reduced coefficients: see [`mc_table`]).
 pub fn make_model(kind: ModelKind, medium: &Medium) -> Box<dyn Bssrdf> {
     match kind {
         ModelKind::StandardDipole => Box::new(StandardDipole::new(medium.clone())),
@@ -226,5 +237,6 @@ pub fn make_model(kind: ModelKind, medium: &Medium) -> Box<dyn Bssrdf> {
         ModelKind::DirectionalDipole => Box::new(DirectionalDipole::new(medium.clone())),
         ModelKind::PhotonBeamDiffusion => Box::new(PhotonBeamDiffusion::new(medium.clone())),
         ModelKind::Burley => Box::new(ChristensenBurley::new(medium.clone())),
+        ModelKind::McTable => Box::new(McTableModel::new(medium.clone())),
     }
 }

@@ -63,6 +63,8 @@ use rayon::prelude::*;
 use sss_util::splitmix64;
 use std::sync::Mutex;
 
+pub mod condensed;
+
 /// Photons per chunk: the unit of parallel work and of RNG seeding.
 pub const CHUNK_PHOTONS: u64 = 4096;
 
@@ -107,10 +109,44 @@ pub struct McConfig {
     /// Outer radius of the radial bins (mm, finite, > 0). Weight escaping beyond it still
     /// counts in [`McProfile::total`].
     pub r_max: f64,
-    /// Number of linear radial bins over [0, r_max] (1..=[`MAX_BINS`]).
+    /// Number of radial bins over [0, r_max] (1..=[`MAX_BINS`]).
     pub bins: usize,
     /// Which channels (red, green, blue) to simulate; at least one. Skipped channels report 0.
     pub channels: [bool; 3],
+    /// How the bins are laid out: equal widths ([`BinSpacing::Linear`]) or given edges
+    /// ([`BinSpacing::Edges`], e.g. log-spaced from [`BinSpacing::geometric`]).
+    pub spacing: BinSpacing,
+}
+
+/// The layout of the radial bins of a [`McConfig`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum BinSpacing {
+    /// `bins` bins of equal width over [0, r_max].
+    #[default]
+    Linear,
+    /// The `bins + 1` edges of the bins in mm: the first 0, strictly increasing, finite, the
+    /// last equal to `r_max`. An exit radius is binned by bisection over them.
+    Edges(Vec<f64>),
+}
+
+impl BinSpacing {
+    /// Log-spaced bins: [0, `first`], then `bins − 1` bins whose edges grow by a constant ratio
+    /// from `first` to `r_max` (`bins ≥ 2`, 0 < `first` < `r_max`, both finite).
+    pub fn geometric(first: f64, r_max: f64, bins: usize) -> Result<BinSpacing, BssrdfError> {
+        if !(first > 0.0 && first < r_max && r_max.is_finite() && (2..=MAX_BINS).contains(&bins)) {
+            return Err(BssrdfError::InvalidArgument(format!(
+                "Monte Carlo: geometric bins need 0 < first ({first}) < r_max ({r_max}), both \
+                 finite, and 2..={MAX_BINS} bins ({bins})"
+            )));
+        }
+        let ratio = (r_max / first).powf(1.0 / (bins - 1) as f64);
+        let mut edges = vec![0.0, first];
+        for k in 1..bins - 1 {
+            edges.push(first * ratio.powi(k as i32));
+        }
+        edges.push(r_max);
+        Ok(BinSpacing::Edges(edges))
+    }
 }
 
 impl McConfig {
@@ -135,6 +171,22 @@ impl McConfig {
         if !self.channels.iter().any(|&c| c) {
             return bad("Monte Carlo: no channel selected".into());
         }
+        if let BinSpacing::Edges(edges) = &self.spacing {
+            let valid = edges.len() == self.bins + 1
+                && edges.first() == Some(&0.0)
+                && edges.last() == Some(&self.r_max)
+                && edges.iter().all(|e| e.is_finite())
+                && edges.windows(2).all(|w| w[0] < w[1]);
+            if !valid {
+                return bad(format!(
+                    "Monte Carlo: {} bin edges given for {} bins; they must be bins + 1 strictly \
+                     increasing finite values from 0 to r_max = {} mm",
+                    edges.len(),
+                    self.bins,
+                    self.r_max
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -142,7 +194,8 @@ impl McConfig {
 /// The tallied radial profile of a simulation. All values are finite.
 #[derive(Clone, Debug, PartialEq)]
 pub struct McProfile {
-    /// Bin edges in mm: `bins + 1` values, linear from 0 to `r_max`.
+    /// Bin edges in mm: `bins + 1` values from 0 to `r_max` (linear, or as given by
+    /// [`BinSpacing::Edges`]).
     pub bin_edges: Vec<f64>,
     /// Per channel, the area-averaged R_d of each bin in 1/mm²: tally / (N · annulus area), per
     /// unit power entering the medium. All zero for channels not simulated.
@@ -211,23 +264,30 @@ pub fn simulate_with_progress(
 
 /// Per-channel parameters of the walk.
 #[derive(Clone, Copy, Debug)]
-struct Walk {
+struct Walk<'a> {
     sigma_t: f64,
     albedo: f64,
     g: f64,
     /// n_t / n_i for light leaving the medium: 1/η.
     eta_out: f64,
     max_events: u64,
-    /// 1 / bin width.
+    /// 1 / bin width (linear bins).
     inv_dr: f64,
     r_max: f64,
     bins: usize,
+    /// The bin edges when they are not linear ([`BinSpacing::Edges`]).
+    edges: Option<&'a [f64]>,
 }
 
-impl Walk {
+impl Walk<'_> {
     /// The radial bin holding exit radius `r`, or `None` beyond `r_max`.
     fn bin(&self, r: f64) -> Option<usize> {
-        (r < self.r_max).then(|| ((r * self.inv_dr) as usize).min(self.bins - 1))
+        match self.edges {
+            None => (r < self.r_max).then(|| ((r * self.inv_dr) as usize).min(self.bins - 1)),
+            Some(edges) => {
+                (r < self.r_max).then(|| edges.partition_point(|&e| e <= r).clamp(1, self.bins) - 1)
+            }
+        }
     }
 }
 
@@ -370,9 +430,14 @@ fn scatter_direction(d: DVec3, cos_theta: f64, cos_phi: f64, sin_phi: f64) -> DV
     n * n.length_squared().sqrt().recip()
 }
 
-/// Traces one photon, depositing escaping weight in `scratch`. Returns `Some(weight)` if it
-/// hit the event cap still carrying `weight`.
-fn trace_photon(walk: &Walk, rng: &mut Pcg64Mcg, scratch: &mut PhotonScratch) -> Option<f64> {
+/// Traces one photon, calling `escape(r, weight, collisions)` for every weight that leaves
+/// through the boundary at radius `r` after `collisions` collisions. Returns `Some(weight)` if
+/// it hit the event cap still carrying `weight`.
+fn trace_photon(
+    walk: &Walk,
+    rng: &mut Pcg64Mcg,
+    escape: &mut impl FnMut(f64, f64, u64),
+) -> Option<f64> {
     let mut p = DVec3::ZERO;
     let mut d = DVec3::NEG_Z;
     let mut w = 1.0_f64;
@@ -392,11 +457,7 @@ fn trace_photon(walk: &Walk, rng: &mut Pcg64Mcg, scratch: &mut PhotonScratch) ->
                     let f = fr_dielectric(d.z, walk.eta_out);
                     let escaped = w * (1.0 - f);
                     if escaped > 0.0 {
-                        let r = p.x.hypot(p.y);
-                        scratch.deposit(walk, r, escaped);
-                        if events == 1 {
-                            scratch.deposit_single(walk, r, escaped);
-                        }
+                        escape(p.x.hypot(p.y), escaped, events);
                     }
                     w *= f;
                     if w <= 0.0 {
@@ -438,7 +499,13 @@ fn run_chunk(walk: &Walk, photons: u64, seed: u64) -> Tally {
         total: 0.0,
     };
     for _ in 0..photons {
-        if let Some(w) = trace_photon(walk, &mut rng, &mut scratch) {
+        let traced = trace_photon(walk, &mut rng, &mut |r, w, events| {
+            scratch.deposit(walk, r, w);
+            if events == 1 {
+                scratch.deposit_single(walk, r, w);
+            }
+        });
+        if let Some(w) = traced {
             tally.capped += 1;
             tally.capped_weight += w;
         }
@@ -468,8 +535,18 @@ pub(crate) fn simulate_impl(
     cfg.validate()?;
     let bins = cfg.bins;
     let dr = cfg.r_max / bins as f64;
-    let mut bin_edges: Vec<f64> = (0..=bins).map(|i| i as f64 * dr).collect();
-    bin_edges[bins] = cfg.r_max;
+    let bin_edges: Vec<f64> = match &cfg.spacing {
+        BinSpacing::Linear => {
+            let mut edges: Vec<f64> = (0..=bins).map(|i| i as f64 * dr).collect();
+            edges[bins] = cfg.r_max;
+            edges
+        }
+        BinSpacing::Edges(edges) => edges.clone(),
+    };
+    let given_edges = match &cfg.spacing {
+        BinSpacing::Linear => None,
+        BinSpacing::Edges(_) => Some(bin_edges.as_slice()),
+    };
 
     let walks: [Walk; 3] = std::array::from_fn(|ch| Walk {
         sigma_t: medium.sigma_t(ch),
@@ -480,6 +557,7 @@ pub(crate) fn simulate_impl(
         inv_dr: 1.0 / dr,
         r_max: cfg.r_max,
         bins,
+        edges: given_edges,
     });
 
     let n_chunks = cfg.photons.div_ceil(CHUNK_PHOTONS);
@@ -591,6 +669,7 @@ mod tests {
             r_max,
             bins,
             channels: [true, false, false],
+            spacing: BinSpacing::Linear,
         }
     }
 

@@ -249,6 +249,35 @@ impl SplineRow {
         }
     }
 
+    /// The same row with its first segment replaced by the straight line between its knot
+    /// values (d₀ = d₁ = f₁ − f₀) and the running integral recomputed. For a row of 2πx R_d
+    /// that starts at 0 this makes R_d constant on the first interval: a Catmull-Rom first
+    /// segment from 0 has R_d ∝ f₁ + (f₁ − d₁) t(1 − t), a bump of (f₁ − d₁)/4 in the middle of
+    /// the interval whenever the next knot's slope differs from the segment's own (the
+    /// `mc-table` profile, whose 2πx R_d is nearly flat near 0, would bump by up to 22 %).
+    pub fn with_linear_first_segment(&self) -> SplineRow {
+        let mut segments = self.segments.clone();
+        if let Some(s) = segments.first_mut() {
+            let slope = s.f1 - s.f0;
+            *s = Segment {
+                d0: slope,
+                d1: slope,
+                c: [s.f0, slope, 0.0, 0.0],
+                ..*s
+            };
+        }
+        let mut cdf = vec![0.0; segments.len() + 1];
+        for (i, s) in segments.iter().enumerate() {
+            // ∫ over the segment: w ((f₀ + f₁)/2 + (d₀ − d₁)/12) (pbrt §8.6.1).
+            cdf[i + 1] = cdf[i] + s.width * (0.5 * (s.f0 + s.f1) + (s.d0 - s.d1) / 12.0);
+        }
+        SplineRow {
+            index: self.index.clone(),
+            segments,
+            cdf,
+        }
+    }
+
     /// The row through `values` (one per knot of `index`), its integral computed as in
     /// [`crate::catmull_rom::integrate_catmull_rom`].
     pub fn new(index: &KnotIndex, values: &[f64]) -> Self {

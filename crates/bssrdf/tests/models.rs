@@ -3,7 +3,7 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use sss_bssrdf::monte_carlo::{McConfig, simulate};
+use sss_bssrdf::monte_carlo::{BinSpacing, McConfig, simulate};
 use sss_bssrdf::presets::PRESETS;
 use sss_bssrdf::quadrature::{integrate, integrate_radial};
 use sss_bssrdf::*;
@@ -275,6 +275,7 @@ fn reflectance_inversion_round_trips() {
         ModelKind::BetterDipole,
         ModelKind::PhotonBeamDiffusion,
         ModelKind::Burley,
+        ModelKind::McTable,
     ] {
         for (g, eta) in [(0.0, 1.33), (0.5, 1.5)] {
             for &t in &targets {
@@ -290,10 +291,14 @@ fn reflectance_inversion_round_trips() {
                     // pbrt's PBD table stops at ~200 mean free paths, which truncates the
                     // profile of forward-scattering media: their highest reflectances are out
                     // of reach, and must be reported as such, never silently clamped.
+                    // The mc-table profile is the random walk's: at albedo 1 it reflects
+                    // 0.98-0.995 (what escapes beyond ≈ 960 mean free paths and after 10⁶
+                    // collisions is missing), so 0.99 and 0.999 may be out of its reach.
                     Err(BssrdfError::UnreachableReflectance { max, .. }) => {
                         assert!(
-                            kind == ModelKind::PhotonBeamDiffusion && g > 0.0,
-                            "{kind} g{g}: {t}"
+                            (kind == ModelKind::PhotonBeamDiffusion && g > 0.0)
+                                || (kind == ModelKind::McTable && t >= 0.99 && max > 0.98),
+                            "{kind} g{g}: {t} (max {max})"
                         );
                         assert!(t > max && max > 0.9, "{kind} g{g}: {t} vs max {max}");
                     }
@@ -356,6 +361,7 @@ fn models_against_monte_carlo() {
             r_max: 8.0,
             bins,
             channels: [true; 3],
+            spacing: BinSpacing::Linear,
         },
     )
     .unwrap();

@@ -27,7 +27,7 @@
 //! nothing and R = 1 − H(1)√(1 − ω), the identity the unit tests use.
 
 use sss_bssrdf::Medium;
-use sss_bssrdf::monte_carlo::{McConfig, simulate};
+use sss_bssrdf::monte_carlo::{BinSpacing, McConfig, simulate};
 use sss_bssrdf::quadrature::gauss_legendre;
 
 const PI: f64 = std::f64::consts::PI;
@@ -225,6 +225,7 @@ fn monte_carlo_total_matches_the_deterministic_solver_with_a_refractive_boundary
                 r_max: 10.0,
                 bins: 4,
                 channels: [true, false, false],
+                spacing: BinSpacing::Linear,
             },
         )
         .unwrap();

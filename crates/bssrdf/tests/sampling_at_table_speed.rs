@@ -50,8 +50,8 @@ impl<'a> Cdf<'a> {
             grid.push(r);
             r *= 1.01;
         }
-        // The end of a tabulated support (PBD: its last radius node, where the pdf drops to
-        // 0) must be a panel edge.
+        // The end of a tabulated support (PBD, mc-table: the last radius node, where the pdf
+        // drops to 0) must be a panel edge.
         let end = model.sample_sr(ch, 1.0);
         if end > 0.0 && end < *grid.last().unwrap() {
             let k = grid.partition_point(|&g| g < end);
@@ -97,8 +97,9 @@ fn tolerance(kind: ModelKind) -> f64 {
 #[test]
 fn pdf_integrates_to_one_and_samples_are_its_quantiles() {
     // Largest |∫ pdf − 1| and |CDF(sample(u)) − u| per model, with where they occurred.
-    let mut worst_total: [(f64, String); 5] = std::array::from_fn(|_| (0.0, String::new()));
-    let mut worst_quantile: [(f64, String); 5] = std::array::from_fn(|_| (0.0, String::new()));
+    const N: usize = ModelKind::ALL.len();
+    let mut worst_total: [(f64, String); N] = std::array::from_fn(|_| (0.0, String::new()));
+    let mut worst_quantile: [(f64, String); N] = std::array::from_fn(|_| (0.0, String::new()));
     for m in media() {
         for (ki, kind) in ModelKind::ALL.into_iter().enumerate() {
             let model = make_model(kind, &m);

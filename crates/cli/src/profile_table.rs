@@ -21,7 +21,7 @@
 use crate::Error;
 use crate::medium_spec::medium_label;
 pub use crate::medium_spec::{MediumSpec, build_medium};
-use sss_bssrdf::monte_carlo::{self, McConfig};
+use sss_bssrdf::monte_carlo::{self, BinSpacing, McConfig};
 use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_plot::{CHANNEL_COLORS, ErrorStyle, PlotError, Series, line_plot};
 use std::io::Write;
@@ -43,6 +43,8 @@ pub enum ProfileModel {
     Pbd,
     /// Christensen-Burley normalized diffusion (Christensen & Burley 2015).
     Burley,
+    /// The crate's photon random walk, tabulated (η in [1, 1.5]).
+    McTable,
     /// The Monte Carlo photon random walk of `sss_bssrdf::monte_carlo`.
     MonteCarlo,
 }
@@ -56,6 +58,7 @@ impl ProfileModel {
             ProfileModel::DirectionalDipole => Some(ModelKind::DirectionalDipole),
             ProfileModel::Pbd => Some(ModelKind::PhotonBeamDiffusion),
             ProfileModel::Burley => Some(ModelKind::Burley),
+            ProfileModel::McTable => Some(ModelKind::McTable),
             ProfileModel::MonteCarlo => None,
         }
     }
@@ -254,6 +257,15 @@ pub fn compute(
     check_request(req)?;
     let medium = build_medium(&req.medium, req.eta)?;
     let medium_label = medium_label(&req.medium, &medium);
+    if req.model == ProfileModel::McTable && !sss_bssrdf::mc_table::eta_in_range(medium.eta()) {
+        return Err(Error::Input(format!(
+            "--eta {} is outside the range of the mc-table tables (η from {} to {}); use \
+             another model for this medium",
+            medium.eta(),
+            sss_bssrdf::mc_table::ETAS[0],
+            sss_bssrdf::mc_table::ETAS[sss_bssrdf::mc_table::ETAS.len() - 1]
+        )));
+    }
     let (total, rows) = match req.model.kind() {
         Some(kind) => {
             let model = make_model(kind, &medium);
@@ -283,6 +295,7 @@ pub fn compute(
                 r_max: req.r_max,
                 bins: req.steps,
                 channels: [true; 3],
+                spacing: BinSpacing::Linear,
             };
             let mc = monte_carlo::simulate_with_progress(&medium, &cfg, progress)?;
             let rows = mc

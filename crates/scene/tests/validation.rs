@@ -468,6 +468,15 @@ fn material_errors() {
         Some("materials.jelly.eta"),
         &["> 0"],
     );
+    // mc-table has tables for η from 1 to 1.5 only; inside that range the material loads.
+    assert_err(
+        &with("eta = 1.4", "model = \"mc-table\"\neta = 1.6"),
+        Some("eta = 1.6"),
+        Some("materials.jelly.eta"),
+        &["mc-table", "from 1 to 1.5", "1.6"],
+    );
+    let ok = with("eta = 1.4", "model = \"mc-table\"\neta = 1.45");
+    assert!(load_str(&ok, "ok.toml", None, &no_dirs()).is_ok());
     assert_err(
         &with(
             "sigma_a = [0.01, 0.02, 0.03]",

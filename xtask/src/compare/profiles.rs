@@ -15,6 +15,7 @@ use super::metrics::{
 use super::output::{csv_num, md_num, md_pct, md_table, write_atomic};
 use super::reference::{CHANNEL_NAMES, McPart, PresetReference};
 use super::{Context, Error, Experiment, Section};
+use sss_bssrdf::mc_table::McTable;
 use sss_bssrdf::photon_beam_diffusion::PbdTable;
 use sss_bssrdf::{Bssrdf, Medium, ModelKind, make_model};
 use sss_plot::{ErrorStyle, PALETTE, Panel, Series, SeriesStyle, panel_plot};
@@ -49,17 +50,19 @@ impl ProfileMethod for ModelMethod {
         make_model(self.0, medium)
     }
 
-    /// Photon beam diffusion models single and multiple scattering, and normalized diffusion
-    /// (Christensen & Burley 2015) is fitted to Monte Carlo profiles of all scattering orders.
+    /// Photon beam diffusion models single and multiple scattering, normalized diffusion
+    /// (Christensen & Burley 2015) is fitted to Monte Carlo profiles of all scattering orders,
+    /// and `mc-table` is the Monte Carlo transport itself, tabulated.
     /// The directional dipole (Frisvad et al. 2014) puts a source of strength 1, not α′, at
     /// the ray's first scattering event, so it stands for all scattered light and is measured
     /// against the full tally too. The standard and better dipoles model multiple scattering
     /// only.
     fn reference_part(&self) -> McPart {
         match self.0 {
-            ModelKind::PhotonBeamDiffusion | ModelKind::Burley | ModelKind::DirectionalDipole => {
-                McPart::All
-            }
+            ModelKind::PhotonBeamDiffusion
+            | ModelKind::Burley
+            | ModelKind::DirectionalDipole
+            | ModelKind::McTable => McPart::All,
             ModelKind::StandardDipole | ModelKind::BetterDipole => McPart::Multiple,
         }
     }
@@ -67,7 +70,9 @@ impl ProfileMethod for ModelMethod {
     fn cold_build_seconds(&self, medium: &Medium) -> f64 {
         // Warm the shared caches, then time a build that redoes the cached part explicitly:
         // photon beam diffusion shares its table per (g, η); that table is its real cost.
-        // Normalized diffusion takes its surface albedo from the table of (0, η).
+        // Normalized diffusion takes its surface albedo from the table of (0, η). `mc-table`
+        // reads its embedded tallies and solves their splines once per process; a cold build
+        // redoes that for the two η tables it blends.
         black_box(self.build(medium));
         (0..3)
             .map(|_| {
@@ -78,6 +83,9 @@ impl ProfileMethod for ModelMethod {
                     }
                     ModelKind::Burley => {
                         black_box(PbdTable::new(0.0, medium.eta()));
+                    }
+                    ModelKind::McTable => {
+                        black_box(McTable::from_embedded_uncached(medium.eta()));
                     }
                     _ => {}
                 }
@@ -567,8 +575,9 @@ impl Experiment for ProfileComparison {
              everything minus the photons that escaped after exactly one collision). Photon beam \
              diffusion models single and multiple scattering, normalized diffusion (`burley`) is \
              fitted to profiles of all orders, and the directional dipole's source has strength \
-             1 rather than α′ (Frisvad et al. 2014), so it stands for all scattered light: these \
-             three are compared with everything (`all`). As published the directional dipole \
+             1 rather than α′ (Frisvad et al. 2014), so it stands for all scattered light; \
+             `mc-table` is the random walk itself, tabulated: these four are compared with \
+             everything (`all`). As published the directional dipole \
              integrates to more than the transport gives at high albedo (≈ 1.34 for α′ → 1 at \
              η = 1, see `directional_dipole.rs`); that excess is the model's, and its total \
              diffuse reflectance is clamped to 1. Standard errors are those of the full tally.\n\
@@ -576,7 +585,8 @@ impl Experiment for ProfileComparison {
              rounds of {TIMING_CALLS}; *ns / RGB eval*: one `rd_rgb(r)`.\n\
              - *cold build*: constructing the model without process-wide caches (for `pbd` this \
              includes its albedo × radius table, for `burley` the g = 0 table its surface albedo \
-             comes from).",
+             comes from, for `mc-table` reading its embedded tallies and solving the splines of \
+             the two η tables it blends).",
             100.0 * MAX_REL_SE
         );
         Ok(Section {
@@ -672,6 +682,10 @@ mod tests {
         ));
         assert!(matches!(
             ModelMethod(ModelKind::Burley).reference_part(),
+            McPart::All
+        ));
+        assert!(matches!(
+            ModelMethod(ModelKind::McTable).reference_part(),
             McPart::All
         ));
     }

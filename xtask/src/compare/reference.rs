@@ -14,7 +14,7 @@
 
 use super::checked::{self, Entry};
 use super::{Config, Error};
-use sss_bssrdf::monte_carlo::{self, McConfig};
+use sss_bssrdf::monte_carlo::{self, BinSpacing, McConfig};
 use sss_bssrdf::presets::Preset;
 use sss_bssrdf::{Medium, ModelKind, make_model};
 use std::fmt::Write as _;
@@ -269,6 +269,7 @@ pub fn load_or_compute(
                 r_max: r_max_for(&medium, ch),
                 bins: config.bins,
                 channels: std::array::from_fn(|c| c == ch),
+                spacing: BinSpacing::Linear,
             };
             let path = cache_path(&dir, preset.name, ch, &cfg);
             let key = key_line(preset.name, ch, &cfg);
@@ -347,6 +348,7 @@ mod tests {
             r_max: 0.1 + 0.2,
             bins: 2,
             channels: [true, false, false],
+            spacing: BinSpacing::Linear,
         };
         let r = ChannelReference {
             r_max: cfg.r_max,
@@ -385,6 +387,7 @@ mod tests {
             r_max: 2.0,
             bins: 2,
             channels: [true, false, false],
+            spacing: BinSpacing::Linear,
         };
         let r = ChannelReference {
             r_max: cfg.r_max,

@@ -406,6 +406,7 @@ impl CliFiles {
             "directional-dipole",
             "pbd",
             "burley",
+            "mc-table",
             "monte-carlo",
             "--preset",
             "skin1",

@@ -57,6 +57,19 @@ impl Ctx<'_> {
                         ),
                     ));
                 }
+                if model == ModelKind::McTable && !sss_bssrdf::mc_table::eta_in_range(eta) {
+                    let etas = sss_bssrdf::mc_table::ETAS;
+                    return Err(self.err(
+                        &key("eta"),
+                        format!(
+                            "model `mc-table` is tabulated for a relative index of refraction \
+                             from {} to {}, got {}; choose another model for this material",
+                            fmt_num(etas[0]),
+                            fmt_num(etas[etas.len() - 1]),
+                            fmt_num(eta)
+                        ),
+                    ));
+                }
                 let (sigma_a, sigma_s) = match (&m.preset, m.sigma_a, m.sigma_s) {
                     (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
                         let k = if m.sigma_a.is_some() {

@@ -1,0 +1,1891 @@
+//! `mc-table`: the radial profile of the crate's own photon random walk ([`crate::monte_carlo`])
+//! tabulated once over single-scattering albedo, optical radius and relative index η, and
+//! evaluated and sampled like the photon beam diffusion table (pbrt 3rd ed. §11.4.2, §15.4.2:
+//! Catmull-Rom in albedo and radius, [`SplineRow`] rows pre-blended per channel), so a
+//! renderer gets the random walk's profile at the cost of a table lookup.
+//!
+//! # The table
+//! - **Optical units.** Every walk runs in a medium of unit extinction (σ_t = 1, albedo
+//!   ρ = σ_s, σ_a = 1 − ρ), g = 0. A medium of extinction σ_t has the profile
+//!   R_d(r) = σ_t² R_d¹(σ_t r), R_d¹ the unit-extinction profile (lengths scale by 1/σ_t; the
+//!   same scaling as pbrt Eq. 11.10 and [`crate::PhotonBeamDiffusion`]). The table stores
+//!   T(ρ, x) = 2πx R_d¹(x), as PBD's table does.
+//! - **Anisotropy.** The table has g = 0; a medium with g ≠ 0 is mapped by the similarity
+//!   relation to its reduced coefficients σ'_s = σ_s (1 − g), σ'_t = σ_a + σ'_s, ρ' = σ'_s/σ'_t
+//!   (Wyman, Patterson, Wilson, *Similarity relations for the interaction parameters in
+//!   radiation transport*, Appl. Opt. 28(24), 1989; Jensen et al. 2001 §2.4). This is exact for
+//!   the presets (Jensen et al. 2001 give σ'_s with g = 0) and an approximation otherwise,
+//!   measured against the walk with the true g: marble with g = 0.5 keeps its totals (within
+//!   0.2 %) but not the shape near the entry point (+24–29 % at 0.25 reduced mean free paths,
+//!   −6 to −11 % at 1–3); skin1 with g = 0.8 is off by +50–70 % at 0.25, −12 to −32 % at 1–4
+//!   and +1.4, +10, +25 % in its totals (red, green, blue). Photon beam diffusion, which
+//!   keeps g in its single scattering, is the better model for such media.
+//! - **Albedos.** [`N_RHO`] albedos on the grid of photon beam diffusion,
+//!   ρ_i = (1 − e^{−8i/99})/(1 − e^{−8}) (pbrt §15.5.5), dense near 1.
+//! - **Radii.** [`radius_knots`]: 0, then from 0.005 mean free paths steps of 20 % (geometric,
+//!   as PBD's grid) until the step reaches 0.75, steps of 0.75 up to 16, then growing again by
+//!   0.2 per unit beyond, up to ≈ 1000 mean free paths. The linear stretch keeps Catmull-Rom's
+//!   error on exponential tails small: a spline through e^{−σx} at spacing h is off by 0.8 %
+//!   mid-interval at σh = 0.75 and 2.5 % at σh = 1, and every ρ ≥ 0.5 decays at σ < 1 per mean
+//!   free path, while 20 % geometric steps would give σh > 3 at 16 mean free paths.
+//! - **η.** One table per η in [`ETAS`] (1.0 to 1.5 in steps of 0.1); between them the
+//!   profile is interpolated linearly in η (which keeps it non-negative and keeps ρ_eff
+//!   non-decreasing in ρ); the totals' curvature in η makes that < 0.3 % off at 0.1 spacing.
+//!   Outside [1.0, 1.5] the nearest end table is used: [`McTableModel::eta_in_range`] says
+//!   whether that happened, and the scene loader and `sss profile` refuse such media.
+//!
+//! # From tallies to a spline
+//! The Monte Carlo tallies the escaped weight in bins around the knots (edges at the midpoints
+//! between knots, [`tally_edges`]), i.e. bin integrals M_k = ∫ T over bin k, not point values.
+//! A spline through bin averages would be biased by the curvature (at 20 % steps on an
+//! exponential tail, several per cent). Instead the knot values v are solved so that the
+//! spline's integral over every bin equals its tally, ∫_bin_k S(v) = M_k (histopolation: a
+//! square linear system, close to the identity in the sense that each bin integral is
+//! dominated by its own knot, so the tallies' noise is not amplified much). The spline has one
+//! knot more than the tallies have knots, at 0.1 x₁ ([`spline_knots`]), so that the first bin
+//! [0, x₁] — where T tends to a positive constant from single scattering but the spline must
+//! start at 0 — is fitted like the others. Before the solve, the narrow, noisy bins near the
+//! origin and the poorly resolved far tail are pooled into resolved groups ([`inner_masses`],
+//! [`tail_masses`]); after it, R_d at the knots is made non-increasing by an isotonic fit
+//! ([`row_nodes`]), and the model makes the first interval [0, 0.1 x₁] linear in T
+//! ([`SplineRow::with_linear_first_segment`]). The spline then reproduces every tallied bin
+//! integral where the tallies are resolved and ordered, and its total stays within 3 standard
+//! errors of the tallied total reflectance for every albedo ≥ 0.5 (tested).
+//!
+//! # Generation
+//! [`McTableData::generate`] (run by `cargo xtask tables`) simulates every η and albedo band
+//! with the condensed walk of [`crate::monte_carlo::condensed`] (one walk per band, every
+//! albedo row of the band tallied from the same photons) with fixed seeds, so the result is
+//! bit-identical for any thread count; [`McTableData::to_bytes`] writes it, and the crate
+//! embeds `data/mc_table.bin`. The bin masses and their standard errors are stored as f32
+//! (their relative rounding, 6·10⁻⁸, is far below the Monte Carlo noise; rounding keeps the
+//! order of values, so the rows stay non-decreasing in ρ).
+
+#![allow(
+    clippy::neg_cmp_op_on_partial_ord,
+    reason = "`!(x > 0.0)` deliberately treats NaN as failing the guard"
+)]
+
+use crate::catmull_rom::{
+    apply_weights, catmull_rom_weights, integrate_catmull_rom, interpolate_catmull_rom,
+};
+use crate::monte_carlo::MAX_SCATTERING_EVENTS;
+use crate::monte_carlo::condensed::{CondensedConfig, simulate_albedos};
+use crate::quadrature::gauss_legendre;
+use crate::spline_row::{KnotIndex, SplineRow};
+use crate::{Bssrdf, BssrdfError, Medium, ModelKind, Rgb};
+use std::collections::HashMap;
+use std::f64::consts::PI;
+use std::ops::Range;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Number of single-scattering albedo rows (the grid of photon beam diffusion, pbrt §15.5.5).
+pub const N_RHO: usize = 100;
+
+/// The relative indices of refraction with a table of their own.
+pub const ETAS: [f64; 6] = [1.0, 1.1, 1.2, 1.3, 1.4, 1.5];
+
+/// The η of the measured presets (Jensen et al. 2001), simulated with the most photons.
+pub const MAIN_ETA: f64 = 1.3;
+
+/// Photons of the other η tables are those of [`MAIN_ETA`] divided by this.
+pub const OTHER_ETA_PHOTON_DIVISOR: u64 = 2;
+
+/// Master seed of every table walk.
+pub const SEED: u64 = 0x6d63_5f74_6162_6c65;
+
+/// Upper ends of the albedo bands, as 1 − ρ: band b holds the rows with
+/// `BAND_BOUNDS[b] ≤ 1 − ρ < BAND_BOUNDS[b − 1]`; the last band reaches ρ = 1.
+const BAND_BOUNDS: [f64; 7] = [0.3, 0.1, 0.03, 0.01, 0.003, 0.001, 0.000_3];
+
+/// The walks of each albedo band at [`MAIN_ETA`]: strata by collision count, each (last
+/// collision count of the stratum, photons); a stratum starts after the previous one's last
+/// count, the first at 1, and the last ends at [`MAX_SCATTERING_EVENTS`]. Bands near ρ = 1
+/// split their walks: many short walks for what escapes early (the profile near the entry
+/// point) and fewer full walks for the rest.
+pub const BAND_STRATA: [&[(u64, u64)]; 8] = [
+    &[(MAX_SCATTERING_EVENTS, 24_000_000)],
+    &[(MAX_SCATTERING_EVENTS, 10_000_000)],
+    &[(MAX_SCATTERING_EVENTS, 5_000_000)],
+    &[(64, 2_000_000), (MAX_SCATTERING_EVENTS, 900_000)],
+    &[
+        (64, 2_000_000),
+        (1024, 1_200_000),
+        (MAX_SCATTERING_EVENTS, 30_000),
+    ],
+    &[
+        (64, 2_000_000),
+        (1024, 1_200_000),
+        (MAX_SCATTERING_EVENTS, 30_000),
+    ],
+    &[
+        (64, 2_000_000),
+        (1024, 1_200_000),
+        (32_768, 50_000),
+        (MAX_SCATTERING_EVENTS, 1_000),
+    ],
+    &[
+        (64, 2_000_000),
+        (1024, 1_100_000),
+        (32_768, 66_000),
+        (MAX_SCATTERING_EVENTS, 2_000),
+    ],
+];
+
+/// First knot after 0 (optical radius).
+const FIRST_KNOT: f64 = 0.005;
+/// Relative step of the geometric parts of the radius grid.
+const GEOMETRIC_STEP: f64 = 0.2;
+/// Step of the linear part of the radius grid (mean free paths).
+const LINEAR_STEP: f64 = 0.75;
+/// End of the linear part: beyond it the step grows by 0.2 per mean free path.
+const LINEAR_END: f64 = 16.0;
+/// The grid stops before its step would pass this optical radius.
+const LAST_KNOT_LIMIT: f64 = 1100.0;
+
+/// The albedo rows ρ_i = (1 − e^{−8i/99})/(1 − e^{−8}), i = 0..[`N_RHO`] (pbrt §15.5.5).
+pub fn rho_samples() -> Vec<f64> {
+    let denom = 1.0 - (-8.0f64).exp();
+    (0..N_RHO)
+        .map(|i| (1.0 - (-8.0 * i as f64 / (N_RHO - 1) as f64).exp()) / denom)
+        .collect()
+}
+
+/// The optical radius knots: 0, 0.005, then x_{k+1} = x_k + min(0.2 x_k, 0.75 + 0.2 max(0,
+/// x_k − 16)) up to ≈ 1000 (see the module documentation).
+pub fn radius_knots() -> Vec<f64> {
+    let mut x = vec![0.0, FIRST_KNOT];
+    loop {
+        let last = x[x.len() - 1];
+        let step = (GEOMETRIC_STEP * last)
+            .min(LINEAR_STEP + GEOMETRIC_STEP * (last - LINEAR_END).max(0.0));
+        let next = last + step;
+        if next > LAST_KNOT_LIMIT {
+            return x;
+        }
+        x.push(next);
+    }
+}
+
+/// The tally bins of `knots` (n knots → n bins, n + 1 edges): bin 0 is [0, x₁]; bin k
+/// (1 ≤ k ≤ n − 1) holds knot k and reaches to the midpoints between it and its neighbours,
+/// except that bin 1 starts at x₁ and bin n − 1 ends at x_{n−1}.
+pub fn tally_edges(knots: &[f64]) -> Vec<f64> {
+    let n = knots.len();
+    let mut edges = Vec::with_capacity(n + 1);
+    edges.push(0.0);
+    if n >= 2 {
+        edges.push(knots[1]);
+        for k in 2..n {
+            edges.push(0.5 * (knots[k - 1] + knots[k]));
+        }
+        edges.push(knots[n - 1]);
+    }
+    edges
+}
+
+/// One walk of the table of one η: a stratum of collision counts of one albedo band.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Walks {
+    /// The albedo rows of the band.
+    pub rows: Range<usize>,
+    /// Weight escaping after `min_events..=max_events` collisions is tallied.
+    pub min_events: u64,
+    /// See `min_events`.
+    pub max_events: u64,
+    /// Photons of the walk.
+    pub photons: u64,
+    /// The walk's stream (distinct for every walk of every η).
+    pub stream: usize,
+}
+
+/// The rows of each albedo band (by [`BAND_BOUNDS`] on 1 − ρ).
+fn band_rows(rho: &[f64]) -> Vec<Range<usize>> {
+    let mut bands = Vec::new();
+    let mut start = 0;
+    for bound in BAND_BOUNDS {
+        let end = start
+            + rho[start..]
+                .iter()
+                .take_while(|&&r| 1.0 - r >= bound)
+                .count();
+        bands.push(start..end);
+        start = end;
+    }
+    bands.push(start..rho.len());
+    bands
+}
+
+/// The walks of the table of `ETAS[eta_index]`, with photon counts multiplied by `scale`
+/// (1 for the table in the repository; at least one photon per walk).
+pub fn plan(eta_index: usize, scale: f64) -> Vec<Walks> {
+    let rho = rho_samples();
+    let divisor = if ETAS.get(eta_index) == Some(&MAIN_ETA) {
+        1
+    } else {
+        OTHER_ETA_PHOTON_DIVISOR
+    };
+    let per_eta: usize = BAND_STRATA.iter().map(|s| s.len()).sum();
+    let mut stream = eta_index * per_eta;
+    let mut walks = Vec::with_capacity(per_eta);
+    for (rows, strata) in band_rows(&rho).into_iter().zip(BAND_STRATA) {
+        let mut min_events = 1;
+        for &(max_events, photons) in strata {
+            walks.push(Walks {
+                rows: rows.clone(),
+                min_events,
+                max_events,
+                photons: (((photons / divisor) as f64 * scale).round() as u64).max(1),
+                stream,
+            });
+            stream += 1;
+            min_events = max_events + 1;
+        }
+    }
+    walks
+}
+
+/// The table file embedded in the crate.
+const EMBEDDED: &[u8] = include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/mc_table.bin"));
+
+/// File magic of the table data (version 1).
+const MAGIC: &[u8; 8] = b"SSSMCT\x01\x00";
+
+/// FNV-1a 64 (Fowler, Noll, Vo) of `bytes`: the checksum of the table file.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The Monte Carlo tallies behind the table: for every η of [`ETAS`] and albedo row, the
+/// escaped weight per photon in each bin of [`tally_edges`] (∫ 2πx R_d¹ dx over the bin, unit
+/// extinction, g = 0) with its standard error, and the row's total reflectance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct McTableData {
+    seed: u64,
+    etas: Vec<f64>,
+    rho: Vec<f64>,
+    knots: Vec<f64>,
+    edges: Vec<f64>,
+    /// Per η, the walks.
+    walks: Vec<Vec<Walks>>,
+    /// Per (η, row, bin), row-major.
+    mass: Vec<f64>,
+    mass_se: Vec<f64>,
+    /// Per (η, row).
+    total: Vec<f64>,
+    total_se: Vec<f64>,
+    capped_weight: Vec<f64>,
+}
+
+impl McTableData {
+    /// Runs every walk of [`plan`] (photons × `scale`), calling `progress` with a line after
+    /// each. Takes ≈ 700 CPU-seconds at `scale` = 1 (measured on a shared 2-core machine).
+    /// Bit-identical for any number of rayon threads.
+    pub fn generate(scale: f64, progress: &dyn Fn(&str)) -> Result<McTableData, BssrdfError> {
+        if !(scale > 0.0 && scale.is_finite()) {
+            return Err(BssrdfError::InvalidArgument(format!(
+                "mc-table: photon scale {scale} must be finite and > 0"
+            )));
+        }
+        let rho = rho_samples();
+        let knots = radius_knots();
+        let edges = tally_edges(&knots);
+        let bins = edges.len() - 1;
+        let cells = ETAS.len() * N_RHO * bins;
+        let mut data = McTableData {
+            seed: SEED,
+            etas: ETAS.to_vec(),
+            rho: rho.clone(),
+            knots,
+            edges: edges.clone(),
+            walks: Vec::new(),
+            mass: vec![0.0; cells],
+            mass_se: Vec::new(),
+            total: vec![0.0; ETAS.len() * N_RHO],
+            total_se: vec![0.0; ETAS.len() * N_RHO],
+            capped_weight: vec![0.0; ETAS.len() * N_RHO],
+        };
+        // Strata of one band add up: sums of masses and totals, variances in quadrature.
+        let mut var = vec![0.0; cells];
+        let mut total_var = vec![0.0; ETAS.len() * N_RHO];
+        for (e, &eta) in ETAS.iter().enumerate() {
+            let walks = plan(e, scale);
+            for walk in &walks {
+                let start = std::time::Instant::now();
+                let profile = simulate_albedos(&CondensedConfig {
+                    photons: walk.photons,
+                    seed: SEED,
+                    stream: walk.stream,
+                    albedos: rho[walk.rows.clone()].to_vec(),
+                    g: 0.0,
+                    eta,
+                    edges: edges.clone(),
+                    min_events: walk.min_events,
+                    max_events: walk.max_events,
+                })?;
+                for (k, i) in walk.rows.clone().enumerate() {
+                    let cell = (e * N_RHO + i) * bins;
+                    for b in 0..bins {
+                        data.mass[cell + b] += profile.row_mass(k)[b];
+                        var[cell + b] += profile.row_mass_se(k)[b].powi(2);
+                    }
+                    data.total[e * N_RHO + i] += profile.total[k];
+                    total_var[e * N_RHO + i] += profile.total_se[k].powi(2);
+                    if walk.max_events == MAX_SCATTERING_EVENTS {
+                        data.capped_weight[e * N_RHO + i] = profile.capped_weight[k];
+                    }
+                }
+                let stopped = if walk.max_events == MAX_SCATTERING_EVENTS {
+                    format!("{} stopped by the collision cap", profile.capped)
+                } else {
+                    format!("{} walk on past the stratum", profile.capped)
+                };
+                progress(&format!(
+                    "eta {eta}: albedo rows {}..{} (rho {:.6}..{:.6}), collisions {}..={}, {} \
+                     photons, {:.1} s, {stopped}",
+                    walk.rows.start,
+                    walk.rows.end,
+                    rho[walk.rows.start],
+                    rho[walk.rows.end - 1],
+                    walk.min_events,
+                    walk.max_events,
+                    walk.photons,
+                    start.elapsed().as_secs_f64(),
+                ));
+            }
+            data.walks.push(walks);
+        }
+        // Stored as f32 (see the module documentation).
+        for m in data.mass.iter_mut() {
+            *m = *m as f32 as f64;
+        }
+        data.mass_se = var.iter().map(|v| v.sqrt() as f32 as f64).collect();
+        data.total_se = total_var.iter().map(|v| v.sqrt()).collect();
+        Ok(data)
+    }
+
+    /// The binary file (little-endian): magic, seed, sizes, the grids (η, ρ, knots, edges),
+    /// the walks (rows, stream, collision range, photons), per (η, row) the total, its standard error and the capped
+    /// weight as f64, per (η, row, bin) the masses and then their standard errors as f32, and
+    /// the FNV-1a 64 of everything before it.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&self.seed.to_le_bytes());
+        let n_walks = self.walks.first().map_or(0, Vec::len);
+        for n in [self.etas.len(), self.rho.len(), self.knots.len(), n_walks] {
+            out.extend_from_slice(&(n as u32).to_le_bytes());
+        }
+        for v in self
+            .etas
+            .iter()
+            .chain(&self.rho)
+            .chain(&self.knots)
+            .chain(&self.edges)
+        {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        for walks in &self.walks {
+            for w in walks {
+                for v in [w.rows.start, w.rows.end, w.stream] {
+                    out.extend_from_slice(&(v as u32).to_le_bytes());
+                }
+                for v in [w.min_events, w.max_events, w.photons] {
+                    out.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+        }
+        for k in 0..self.total.len() {
+            for v in [self.total[k], self.total_se[k], self.capped_weight[k]] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        for v in self.mass.iter().chain(&self.mass_se) {
+            out.extend_from_slice(&(*v as f32).to_le_bytes());
+        }
+        let sum = fnv1a(&out);
+        out.extend_from_slice(&sum.to_le_bytes());
+        out
+    }
+
+    /// Reads [`McTableData::to_bytes`]'s format. Errors (never panics) on a wrong magic or
+    /// checksum, a truncated file, grids other than this version's ([`ETAS`],
+    /// [`rho_samples`], [`radius_knots`]) or values that are not finite and ≥ 0.
+    pub fn from_bytes(bytes: &[u8]) -> Result<McTableData, BssrdfError> {
+        let bad = |what: &str| {
+            Err(BssrdfError::InvalidArgument(format!(
+                "mc-table data: {what}"
+            )))
+        };
+        if bytes.len() < MAGIC.len() + 8 || &bytes[..MAGIC.len()] != MAGIC {
+            return bad("not a table file of this version (magic)");
+        }
+        let (body, sum) = bytes.split_at(bytes.len() - 8);
+        if fnv1a(body).to_le_bytes() != sum {
+            return bad("checksum mismatch (corrupt or truncated)");
+        }
+        let mut r = Reader {
+            bytes: body,
+            at: MAGIC.len(),
+        };
+        let seed = r.u64()?;
+        let sizes = [r.u32()?, r.u32()?, r.u32()?, r.u32()?].map(|v| v as usize);
+        let [n_eta, n_rho, n_knots, n_walks] = sizes;
+        let etas = r.f64s(n_eta)?;
+        let rho = r.f64s(n_rho)?;
+        let knots = r.f64s(n_knots)?;
+        let edges = r.f64s(n_knots.saturating_add(1))?;
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        let want_knots = radius_knots();
+        if bits(&etas) != bits(&ETAS)
+            || bits(&rho) != bits(&rho_samples())
+            || bits(&knots) != bits(&want_knots)
+            || bits(&edges) != bits(&tally_edges(&want_knots))
+        {
+            return bad("grids differ from this version's (regenerate with `cargo xtask tables`)");
+        }
+        let mut walks = Vec::with_capacity(n_eta);
+        for _ in 0..n_eta {
+            let mut row = Vec::with_capacity(n_walks.min(64));
+            for _ in 0..n_walks {
+                let (start, end, stream) = (r.u32()? as usize, r.u32()? as usize, r.u32()?);
+                let (min_events, max_events, photons) = (r.u64()?, r.u64()?, r.u64()?);
+                if !(start < end && end <= n_rho && photons > 0 && min_events <= max_events) {
+                    return bad("invalid walk");
+                }
+                row.push(Walks {
+                    rows: start..end,
+                    min_events,
+                    max_events,
+                    photons,
+                    stream: stream as usize,
+                });
+            }
+            walks.push(row);
+        }
+        let rows = n_eta.saturating_mul(n_rho);
+        let (mut total, mut total_se, mut capped_weight) = (
+            Vec::with_capacity(rows.min(1 << 16)),
+            Vec::with_capacity(rows.min(1 << 16)),
+            Vec::with_capacity(rows.min(1 << 16)),
+        );
+        for _ in 0..rows {
+            total.push(r.f64()?);
+            total_se.push(r.f64()?);
+            capped_weight.push(r.f64()?);
+        }
+        let cells = rows.saturating_mul(n_knots);
+        let mass = r.f32s(cells)?;
+        let mass_se = r.f32s(cells)?;
+        if r.at != body.len() {
+            return bad("trailing bytes");
+        }
+        let valid = |v: &[f64]| v.iter().all(|x| x.is_finite() && *x >= 0.0);
+        if !(valid(&mass)
+            && valid(&mass_se)
+            && valid(&total)
+            && valid(&total_se)
+            && valid(&capped_weight))
+        {
+            return bad("a tallied value is negative or not finite");
+        }
+        Ok(McTableData {
+            seed,
+            etas,
+            rho,
+            knots,
+            edges,
+            walks,
+            mass,
+            mass_se,
+            total,
+            total_se,
+            capped_weight,
+        })
+    }
+
+    /// The table embedded in the crate (`data/mc_table.bin`), parsed on first use.
+    pub fn embedded() -> Result<&'static McTableData, BssrdfError> {
+        static DATA: OnceLock<Result<McTableData, BssrdfError>> = OnceLock::new();
+        DATA.get_or_init(|| McTableData::from_bytes(EMBEDDED))
+            .as_ref()
+            .map_err(Clone::clone)
+    }
+
+    /// The master seed of the walks.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The η of each table ([`ETAS`]).
+    pub fn etas(&self) -> &[f64] {
+        &self.etas
+    }
+
+    /// The albedo rows ([`rho_samples`]).
+    pub fn rho_samples(&self) -> &[f64] {
+        &self.rho
+    }
+
+    /// The radius knots ([`radius_knots`]).
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
+    /// The tally bin edges ([`tally_edges`]).
+    pub fn edges(&self) -> &[f64] {
+        &self.edges
+    }
+
+    /// The walks of the table of η index `e`.
+    pub fn walks(&self, e: usize) -> &[Walks] {
+        &self.walks[e]
+    }
+
+    fn cell(&self, e: usize, i: usize) -> Range<usize> {
+        let bins = self.knots.len();
+        let start = (e * self.rho.len() + i) * bins;
+        start..start + bins
+    }
+
+    /// The tallied bin masses ∫ 2πx R_d¹ dx of η index `e`, albedo row `i`.
+    pub fn mass(&self, e: usize, i: usize) -> &[f64] {
+        &self.mass[self.cell(e, i)]
+    }
+
+    /// Standard errors of [`McTableData::mass`].
+    pub fn mass_se(&self, e: usize, i: usize) -> &[f64] {
+        &self.mass_se[self.cell(e, i)]
+    }
+
+    /// The tallied total reflectance (all radii) of η index `e`, albedo row `i`, and its
+    /// standard error.
+    pub fn total(&self, e: usize, i: usize) -> (f64, f64) {
+        let k = e * self.rho.len() + i;
+        (self.total[k], self.total_se[k])
+    }
+
+    /// The weight per photon lost to the event cap of the walk (η index `e`, row `i`).
+    pub fn capped_weight(&self, e: usize, i: usize) -> f64 {
+        self.capped_weight[e * self.rho.len() + i]
+    }
+}
+
+/// A little-endian reader over a byte slice that reports truncation as an error.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8], BssrdfError> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
+        let Some(end) = end else {
+            return Err(BssrdfError::InvalidArgument(
+                "mc-table data: truncated".into(),
+            ));
+        };
+        let s = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(s)
+    }
+
+    fn u32(&mut self) -> Result<u32, BssrdfError> {
+        let b = self.take(4)?;
+        Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    }
+
+    fn u64(&mut self) -> Result<u64, BssrdfError> {
+        let b = self.take(8)?;
+        let mut a = [0u8; 8];
+        a.copy_from_slice(b);
+        Ok(u64::from_le_bytes(a))
+    }
+
+    fn f64(&mut self) -> Result<f64, BssrdfError> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+
+    fn f64s(&mut self, n: usize) -> Result<Vec<f64>, BssrdfError> {
+        let b = self.take(n.saturating_mul(8))?;
+        Ok(b.chunks_exact(8)
+            .map(|c| {
+                let mut a = [0u8; 8];
+                a.copy_from_slice(c);
+                f64::from_le_bytes(a)
+            })
+            .collect())
+    }
+
+    fn f32s(&mut self, n: usize) -> Result<Vec<f64>, BssrdfError> {
+        let b = self.take(n.saturating_mul(4))?;
+        Ok(b.chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64)
+            .collect())
+    }
+}
+
+/// Where the extra spline knot of [`spline_knots`] sits in the first tally bin [0, x₁], as a
+/// fraction of x₁.
+const NEAR_ORIGIN_KNOT: f64 = 0.1;
+
+/// The knots of the table's splines: the tally knots ([`radius_knots`]) with one more at
+/// 0.1 x₁. The spline must be 0 at x = 0 (it is 2πx R_d), while the tallied profile T(x) tends
+/// to a positive constant there (single scattering makes R_d ∝ 1/r near the entry point), so
+/// a spline from 0 straight to x₁ would miss half of the first bin's light (≈ 0.3 % of the
+/// total at albedo 0.8); with the extra knot the first bin's tally is fitted like the others.
+pub fn spline_knots(knots: &[f64]) -> Vec<f64> {
+    let mut x = Vec::with_capacity(knots.len() + 1);
+    x.push(0.0);
+    if knots.len() >= 2 {
+        x.push(NEAR_ORIGIN_KNOT * knots[1]);
+        x.extend_from_slice(&knots[1..]);
+    }
+    x
+}
+
+/// The histopolation system of the tally bins of a knot vector ([`tally_edges`]) and the
+/// splines on its [`spline_knots`]: the matrix A with A_kj = ∫_{bin k} φ_j, φ_j the Catmull-Rom
+/// cardinal function of spline knot j (the spline through the unit vector e_j), for every bin
+/// k and every spline knot but the first (fixed at 0) — as many knots as bins —
+/// LU-factorised with partial pivoting (Golub & Van Loan, *Matrix Computations*,
+/// Algorithm 3.4.1).
+#[derive(Clone, Debug)]
+pub struct Histopolation {
+    n: usize,
+    lu: Vec<f64>,
+    pivot: Vec<usize>,
+}
+
+impl Histopolation {
+    /// The system of the tally `knots` (x₀ = 0, increasing). Each bin is split at the spline
+    /// knots it contains and integrated with 3-point Gauss-Legendre, exact for the cubic
+    /// pieces.
+    pub fn new(knots: &[f64]) -> Result<Histopolation, BssrdfError> {
+        let n_knots = knots.len();
+        if n_knots < 3 || knots[0] != 0.0 || !knots.windows(2).all(|w| w[0] < w[1]) {
+            return Err(BssrdfError::InvalidArgument(
+                "histopolation: need ≥ 3 increasing knots from 0".into(),
+            ));
+        }
+        let edges = tally_edges(knots);
+        let xs = spline_knots(knots);
+        let n = n_knots;
+        let mut a = vec![0.0; n * n];
+        let (gx, gw) = gauss_legendre(3);
+        for k in 0..n {
+            let (lo, hi) = (edges[k], edges[k + 1]);
+            let mut cuts = vec![lo];
+            cuts.extend(xs.iter().copied().filter(|&x| x > lo && x < hi));
+            cuts.push(hi);
+            for w in cuts.windows(2) {
+                let (half, mid) = (0.5 * (w[1] - w[0]), 0.5 * (w[1] + w[0]));
+                for (xi, wi) in gx.iter().zip(gw) {
+                    let Some((offset, cw)) = catmull_rom_weights(&xs, mid + half * xi) else {
+                        continue;
+                    };
+                    for (m, c) in cw.iter().enumerate() {
+                        let j = offset + m as isize;
+                        if *c != 0.0 && j >= 1 {
+                            a[k * n + (j as usize - 1)] += half * wi * c;
+                        }
+                    }
+                }
+            }
+        }
+        // LU with partial pivoting, in place.
+        let mut pivot = vec![0; n];
+        for col in 0..n {
+            let p = (col..n)
+                .max_by(|&x, &y| a[x * n + col].abs().total_cmp(&a[y * n + col].abs()))
+                .unwrap_or(col);
+            if !(a[p * n + col].abs() > 0.0) {
+                return Err(BssrdfError::InvalidArgument(
+                    "histopolation: singular system".into(),
+                ));
+            }
+            pivot[col] = p;
+            if p != col {
+                for c in 0..n {
+                    a.swap(p * n + c, col * n + c);
+                }
+            }
+            let d = a[col * n + col];
+            for row in col + 1..n {
+                let f = a[row * n + col] / d;
+                a[row * n + col] = f;
+                if f != 0.0 {
+                    for c in col + 1..n {
+                        a[row * n + c] -= f * a[col * n + c];
+                    }
+                }
+            }
+        }
+        Ok(Histopolation { n, lu: a, pivot })
+    }
+
+    /// The values at spline knots 1.. (see [`spline_knots`]; knot 0 is 0) whose spline
+    /// integrates to `masses[k]` over tally bin k, for every bin.
+    pub fn solve(&self, masses: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut x: Vec<f64> = (0..n)
+            .map(|k| masses.get(k).copied().unwrap_or(0.0))
+            .collect();
+        for col in 0..n {
+            x.swap(col, self.pivot[col]);
+        }
+        // Forward substitution with the unit lower triangle, then back substitution.
+        for row in 0..n {
+            let lower = &self.lu[row * n..row * n + row];
+            let s: f64 = lower.iter().zip(&x[..row]).map(|(l, v)| l * v).sum();
+            x[row] -= s;
+        }
+        for row in (0..n).rev() {
+            let upper = &self.lu[row * n + row + 1..(row + 1) * n];
+            let s: f64 = upper.iter().zip(&x[row + 1..]).map(|(u, v)| u * v).sum();
+            x[row] = (x[row] - s) / self.lu[row * n + row];
+        }
+        x
+    }
+}
+
+/// A tallied bin is resolved when its relative standard error is at most this.
+pub const RESOLVED_REL_SE: f64 = 0.2;
+
+/// Resolved bins fitted by the exponential that continues a row's tail.
+const TAIL_FIT_BINS: usize = 6;
+
+/// Largest relative standard error of the pooled groups near the origin ([`inner_masses`]).
+pub const INNER_REL_SE: f64 = 0.01;
+
+/// The bin masses of one row with the narrow bins near the origin pooled (see
+/// [`row_nodes`]).
+///
+/// The first bins are narrow (5·10⁻⁴ mean free paths at x₁) and their tallies noisy (several
+/// % at albedos near 1, whose bands have fewer photons), and the histopolation system, whose
+/// first bin is 10 times wider than its second, turns that noise into oscillations of the knot
+/// values of 20 % and more. So from bin 0 outward, consecutive bins are pooled into groups
+/// whose relative standard error is at most [`INNER_REL_SE`], until a bin is that precise on
+/// its own (or the bin of largest mass is reached); each group keeps its tallied mass, spread
+/// over its bins by the density interpolated log-linearly between the groups' mean densities.
+/// Near the origin 2πx R_d is smooth (single scattering makes it tend to a constant), so this
+/// changes the profile only within the noise, below 0.1 mean free paths.
+pub fn inner_masses(edges: &[f64], mass: &[f64], se: &[f64]) -> Vec<f64> {
+    let bins = mass.len();
+    let precise = |m: f64, s2: f64| m > 0.0 && s2.sqrt() <= INNER_REL_SE * m;
+    let peak = (0..bins)
+        .max_by(|&a, &b| mass[a].total_cmp(&mass[b]))
+        .unwrap_or(0);
+    let mut groups: Vec<Range<usize>> = Vec::new();
+    let mut k = 0;
+    while k < peak {
+        let (mut m, mut v, mut j) = (0.0, 0.0, k);
+        while j < bins && !precise(m, v) {
+            m += mass[j];
+            v += se[j].powi(2);
+            j += 1;
+        }
+        if !precise(m, v) || j - k == 1 {
+            break;
+        }
+        groups.push(k..j);
+        k = j;
+    }
+    let mut out = mass.to_vec();
+    if groups.is_empty() {
+        return out;
+    }
+    // Mean densities at the groups' centres and at the two bins after them (if any).
+    let end = groups[groups.len() - 1].end;
+    let mut points: Vec<(f64, f64)> = groups
+        .iter()
+        .map(|g| {
+            let (lo, hi) = (edges[g.start], edges[g.end]);
+            (
+                0.5 * (lo + hi),
+                mass[g.clone()].iter().sum::<f64>() / (hi - lo),
+            )
+        })
+        .collect();
+    for k in end..(end + 2).min(bins) {
+        if mass[k] > 0.0 {
+            points.push((
+                0.5 * (edges[k] + edges[k + 1]),
+                mass[k] / (edges[k + 1] - edges[k]),
+            ));
+        }
+    }
+    let log_density_at = |x: f64| -> f64 {
+        if points.len() < 2 {
+            return points[0].1.ln();
+        }
+        let j = points
+            .partition_point(|p| p.0 <= x)
+            .clamp(1, points.len() - 1);
+        let ((c0, d0), (c1, d1)) = (points[j - 1], points[j]);
+        let t = (x - c0) / (c1 - c0);
+        (1.0 - t) * d0.ln() + t * d1.ln()
+    };
+    for g in &groups {
+        let target: f64 = mass[g.clone()].iter().sum();
+        let shape: Vec<f64> = g
+            .clone()
+            .map(|k| {
+                let c = 0.5 * (edges[k] + edges[k + 1]);
+                log_density_at(c).exp() * (edges[k + 1] - edges[k])
+            })
+            .collect();
+        let total: f64 = shape.iter().sum();
+        for (k, v) in g.clone().zip(&shape) {
+            let m = target * v / total;
+            out[k] = if m.is_finite() { m.max(0.0) } else { mass[k] };
+        }
+    }
+    out
+}
+
+/// The bin masses of one row with its tail beyond the resolved bins regularised (see
+/// [`row_nodes`]); also returns the last resolved bin K.
+///
+/// - K: outward from the bin of largest mass, the last bin before the first one whose
+///   relative standard error exceeds [`RESOLVED_REL_SE`] (the small bins near the origin may
+///   be noisier than the tail's start, and are kept as tallied).
+/// - Beyond K, consecutive bins are pooled into groups just large enough to be resolved; each
+///   group keeps its tallied mass, spread over its bins by the density interpolated
+///   log-linearly between the groups' (and the last resolved bins') mean densities.
+/// - What cannot be pooled into a resolved group (the last bins, reached by too few photons)
+///   keeps its total tallied mass, spread over its bins like the exponential e^{−κx} fitted
+///   to the last resolved bins and groups (weights (mass/se)², the bin averages'
+///   sinh(κw/2)/(κw/2) factor accounted for), or like 1/x² if that fit does not decay.
+pub fn tail_masses(edges: &[f64], mass: &[f64], se: &[f64]) -> (Vec<f64>, usize) {
+    let bins = mass.len();
+    let resolved = |m: f64, s2: f64| m > 0.0 && s2.sqrt() <= RESOLVED_REL_SE * m;
+    let peak = (1..bins)
+        .max_by(|&a, &b| mass[a].total_cmp(&mass[b]))
+        .unwrap_or(0);
+    let last = if peak >= 1 && resolved(mass[peak], se[peak].powi(2)) {
+        (peak..bins)
+            .take_while(|&k| resolved(mass[k], se[k].powi(2)))
+            .last()
+            .unwrap_or(peak)
+    } else {
+        0
+    };
+    let mut out = mass.to_vec();
+    // Nothing resolved (an empty row), or nothing beyond K: the tally as it is.
+    if last == 0 || last + 1 >= bins {
+        return (out, last);
+    }
+    // Pool the bins beyond K into resolved groups.
+    let mut groups: Vec<Range<usize>> = Vec::new();
+    let mut k = last + 1;
+    let mut rest = bins;
+    while k < bins {
+        let (mut m, mut v, mut j) = (0.0, 0.0, k);
+        while j < bins && !resolved(m, v) {
+            m += mass[j];
+            v += se[j].powi(2);
+            j += 1;
+        }
+        if resolved(m, v) {
+            groups.push(k..j);
+            k = j;
+        } else {
+            rest = k;
+            break;
+        }
+    }
+    // Points (centre, mean density, weight, lo, hi): the last resolved bins, then the groups.
+    struct Point {
+        lo: f64,
+        hi: f64,
+        density: f64,
+        weight: f64,
+    }
+    let first = last.saturating_sub(TAIL_FIT_BINS - 1).max(1);
+    let mut points: Vec<Point> = (first..=last)
+        .map(|k| Point {
+            lo: edges[k],
+            hi: edges[k + 1],
+            density: mass[k] / (edges[k + 1] - edges[k]),
+            weight: if se[k] > 0.0 {
+                (mass[k] / se[k]).powi(2)
+            } else {
+                1.0
+            },
+        })
+        .collect();
+    for g in &groups {
+        let m: f64 = mass[g.clone()].iter().sum();
+        let v: f64 = se[g.clone()].iter().map(|s| s * s).sum();
+        let (lo, hi) = (edges[g.start], edges[g.end]);
+        points.push(Point {
+            lo,
+            hi,
+            density: m / (hi - lo),
+            weight: if v > 0.0 { m * m / v } else { 1.0 },
+        });
+    }
+    // Groups: log-linear density between neighbouring points' centres, rescaled to the
+    // group's tallied mass.
+    let centre = |p: &Point| 0.5 * (p.lo + p.hi);
+    let log_density_at = |x: f64| -> f64 {
+        if points.len() < 2 {
+            return points.first().map_or(0.0, |p| p.density.ln());
+        }
+        let j = points
+            .partition_point(|p| centre(p) <= x)
+            .clamp(1, points.len() - 1);
+        let (a, b) = (&points[j - 1], &points[j]);
+        let slope = (b.density.ln() - a.density.ln()) / (centre(b) - centre(a));
+        if x > centre(b) {
+            // Beyond the last point the density may only fall (a noisy last group must not
+            // pile its mass up at its far end).
+            return b.density.ln() + slope.min(0.0) * (x - centre(b));
+        }
+        a.density.ln() + slope * (x - centre(a))
+    };
+    for g in &groups {
+        let target: f64 = mass[g.clone()].iter().sum();
+        let shape: Vec<f64> = g
+            .clone()
+            .map(|k| {
+                let c = 0.5 * (edges[k] + edges[k + 1]);
+                log_density_at(c).exp() * (edges[k + 1] - edges[k])
+            })
+            .collect();
+        let total: f64 = shape.iter().sum();
+        for (k, v) in g.clone().zip(&shape) {
+            out[k] = if total > 0.0 && total.is_finite() {
+                target * v / total
+            } else {
+                target / g.len() as f64
+            };
+        }
+    }
+    if rest >= bins {
+        return (out, last);
+    }
+    // The unresolved rest keeps its tallied mass (noisy, but without the bias of dropping
+    // it: at albedo 1 it is ≈ 1 % of the light), spread like the exponential fitted to the
+    // last points, or like 1/x² (the albedo-1 tail of 2πx R_d) if that fit does not decay.
+    let rest_mass: f64 = mass[rest..].iter().sum();
+    let fit_from = points.len().saturating_sub(TAIL_FIT_BINS);
+    let fit = &points[fit_from..];
+    let (kappa, _) = fit_exponential(fit.iter().map(|p| (p.lo, p.hi, p.density, p.weight)));
+    let x0 = edges[rest];
+    let shape: Vec<f64> = (rest..bins)
+        .map(|k| {
+            let (lo, hi) = (edges[k], edges[k + 1]);
+            if kappa > 1e-3 {
+                // ∫ e^{−κ(x − x₀)} dx over the bin.
+                (-kappa * (lo - x0)).exp() * (-(-kappa * (hi - lo)).exp_m1()) / kappa
+            } else {
+                1.0 / lo - 1.0 / hi
+            }
+        })
+        .collect();
+    let total: f64 = shape.iter().sum();
+    for (k, v) in (rest..bins).zip(&shape) {
+        let m = rest_mass * v / total;
+        out[k] = if m.is_finite() { m.max(0.0) } else { 0.0 };
+    }
+    (out, last)
+}
+
+/// Weighted least squares of ln(mean density) = a − κc + ln(sinh(κw/2)/(κw/2)) over intervals
+/// (lo, hi, mean density, weight) of width w and centre c: the exponential e^{a − κx} whose
+/// interval means match. Returns (κ, a); κ is NaN when fewer than two intervals are given.
+fn fit_exponential(points: impl Iterator<Item = (f64, f64, f64, f64)> + Clone) -> (f64, f64) {
+    let solve = |kappa: f64| -> Option<(f64, f64)> {
+        let (mut sw, mut sx, mut sy, mut sxx, mut sxy, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0);
+        for (lo, hi, d, w) in points.clone() {
+            let c = 0.5 * (lo + hi);
+            let h = 0.5 * kappa * (hi - lo);
+            let factor = if h > 1e-12 { (h.sinh() / h).ln() } else { 0.0 };
+            let y = d.ln() - factor;
+            if !(y.is_finite() && w > 0.0) {
+                continue;
+            }
+            sw += w;
+            sx += w * c;
+            sy += w * y;
+            sxx += w * c * c;
+            sxy += w * c * y;
+            n += 1;
+        }
+        let det = sw * sxx - sx * sx;
+        if n < 2 || !(det > 0.0) {
+            return None;
+        }
+        let k = -(sw * sxy - sx * sy) / det;
+        Some((k, (sy + k * sx) / sw))
+    };
+    let Some((mut kappa, mut a)) = solve(0.0) else {
+        return (f64::NAN, f64::NAN);
+    };
+    // Fixed-point rounds for the sinh factor (exact at once for equal widths).
+    for _ in 0..6 {
+        if !(kappa > 1e-3) {
+            break;
+        }
+        match solve(kappa) {
+            Some((k, b)) => (kappa, a) = (k, b),
+            None => break,
+        }
+    }
+    (kappa, a)
+}
+
+/// Weighted isotonic regression: the non-increasing sequence closest to `y` in the weighted
+/// least-squares sense, by pooling adjacent violators (Ayer, Brunk, Ewing, Reid, Silverman,
+/// *An empirical distribution function for sampling with incomplete information*, Ann. Math.
+/// Statist. 26(4), 1955; Barlow et al., *Statistical Inference under Order Restrictions*,
+/// 1972).
+pub fn non_increasing_fit(y: &[f64], w: &[f64]) -> Vec<f64> {
+    // Blocks of (mean, weight, count).
+    let mut blocks: Vec<(f64, f64, usize)> = Vec::with_capacity(y.len());
+    for (&v, &wt) in y.iter().zip(w) {
+        let wt = if wt > 0.0 && wt.is_finite() {
+            wt
+        } else {
+            1e-300
+        };
+        blocks.push((v, wt, 1));
+        while blocks.len() >= 2 {
+            let (m1, w1, c1) = blocks[blocks.len() - 1];
+            let (m0, w0, c0) = blocks[blocks.len() - 2];
+            if m1 <= m0 {
+                break;
+            }
+            blocks.pop();
+            let wsum = w0 + w1;
+            let last = blocks.len() - 1;
+            blocks[last] = ((w0 * m0 + w1 * m1) / wsum, wsum, c0 + c1);
+        }
+    }
+    blocks
+        .into_iter()
+        .flat_map(|(m, _, c)| std::iter::repeat_n(m, c))
+        .collect()
+}
+
+/// The values of one row's spline at its [`spline_knots`] from the row's tallies (bins of
+/// [`tally_edges`]):
+/// 1. the narrow bins near the origin are pooled by [`inner_masses`], and the tail beyond the
+///    resolved bins is regularised by [`tail_masses`] (pooled groups, the unresolved rest
+///    spread like the fitted exponential);
+/// 2. the bins' R_d averages over their annuli are made non-increasing by isotonic regression
+///    with the annuli's areas as weights (mass-conserving: pooled bins share their tallied
+///    light), which changes nothing where the tallies are ordered and pools neighbours where
+///    noise reverses them;
+/// 3. the histopolation system gives the knot values whose spline integrates to every bin;
+/// 4. negative values are set to 0, and R_d = T/(2πx) at the knots is made non-increasing by
+///    isotonic regression weighted by the light each knot carries (a knot value can overshoot
+///    its neighbour a little even when the bin averages are ordered).
+pub fn row_nodes(system: &Histopolation, knots: &[f64], mass: &[f64], se: &[f64]) -> Vec<f64> {
+    let xs = spline_knots(knots);
+    let n = xs.len();
+    let edges = tally_edges(knots);
+    let inner = inner_masses(&edges, mass, se);
+    let (tail, _) = tail_masses(&edges, &inner, se);
+    // R_d averaged over each bin's annulus, made non-increasing with the annuli's areas as
+    // weights: pooled bins share their total mass, so no light is gained or lost.
+    let areas: Vec<f64> = edges
+        .windows(2)
+        .map(|e| PI * (e[1] * e[1] - e[0] * e[0]))
+        .collect();
+    let averages: Vec<f64> = tail.iter().zip(&areas).map(|(m, a)| m / a).collect();
+    let masses: Vec<f64> = non_increasing_fit(&averages, &areas)
+        .iter()
+        .zip(&areas)
+        .map(|(d, a)| d * a)
+        .collect();
+    let v = system.solve(&masses);
+    // The spline's own R_d at the knots, made non-increasing too (the bin averages are, but a
+    // knot value can still overshoot its neighbour by a little), weighted by the mass each
+    // knot carries (x times the width of its bin), which keeps the total.
+    let mut u = Vec::with_capacity(n - 1);
+    let mut w = Vec::with_capacity(n - 1);
+    for j in 1..n {
+        let value = v[j - 1];
+        let value = if value.is_finite() {
+            value.max(0.0)
+        } else {
+            0.0
+        };
+        u.push(value / xs[j]);
+        w.push(xs[j] * (edges[j] - edges[j - 1]));
+    }
+    let fitted = non_increasing_fit(&u, &w);
+    let mut out = vec![0.0; n];
+    for j in 1..n {
+        let v = fitted[j - 1] * xs[j];
+        out[j] = if v.is_finite() { v.max(0.0) } else { 0.0 };
+    }
+    out
+}
+
+/// The knot values of every albedo row of η index `e` ([`row_nodes`]). Row-major [`N_RHO`] ×
+/// knots.
+fn node_values(data: &McTableData, e: usize) -> Vec<f64> {
+    let knots = data.knots();
+    let n = knots.len() + 1;
+    let rows = data.rho_samples().len();
+    let mut out = vec![0.0; rows * n];
+    let Ok(system) = Histopolation::new(knots) else {
+        return out;
+    };
+    for i in 0..rows {
+        let v = row_nodes(&system, knots, data.mass(e, i), data.mass_se(e, i));
+        out[i * n..(i + 1) * n].copy_from_slice(&v);
+    }
+    out
+}
+
+/// Per η of [`ETAS`], the knot values of the embedded data (computed once).
+fn embedded_nodes() -> Option<&'static [Vec<f64>]> {
+    static NODES: OnceLock<Option<Vec<Vec<f64>>>> = OnceLock::new();
+    NODES
+        .get_or_init(|| {
+            let data = McTableData::embedded().ok()?;
+            Some(
+                (0..data.etas().len())
+                    .map(|e| node_values(data, e))
+                    .collect(),
+            )
+        })
+        .as_deref()
+}
+
+/// The tabulated Monte Carlo profile for one η (the counterpart of
+/// [`crate::photon_beam_diffusion::PbdTable`]): [`N_RHO`] albedo rows × [`radius_knots`] of
+/// T(ρ, x) = 2πx R_d¹(x) (unit extinction, g = 0), their running integrals and totals.
+#[derive(Clone, Debug)]
+pub struct McTable {
+    eta: f64,
+    rho_samples: Vec<f64>,
+    radius_samples: Vec<f64>,
+    /// Row-major N_RHO × knots values of T.
+    profile: Vec<f64>,
+    /// Row-major running integrals of the profile splines.
+    profile_cdf: Vec<f64>,
+    /// ρ_eff per albedo row: the integral of the row's spline.
+    rho_eff: Vec<f64>,
+    index: KnotIndex,
+}
+
+impl McTable {
+    /// The table for `eta` from the embedded data: η clamped to [1.0, 1.5], then the knot
+    /// values of the two neighbouring tables of [`ETAS`] blended linearly in η. If the
+    /// embedded data could not be read (see [`McTableData::embedded`]) the table is all zeros.
+    pub fn new(eta: f64) -> McTable {
+        let eta = clamp_eta(eta);
+        let (lo, hi, t) = eta_bracket(eta);
+        match embedded_nodes() {
+            Some(nodes) => McTable::from_nodes(eta, &nodes[lo], &nodes[hi], t),
+            None => McTable::from_nodes(eta, &[], &[], t),
+        }
+    }
+
+    /// [`McTable::new`] from `data` without any cache: the spline knot values of the two η
+    /// tables are solved from the tallies here (what the first model of a process pays).
+    pub fn from_data(data: &McTableData, eta: f64) -> McTable {
+        let eta = clamp_eta(eta);
+        let (lo, hi, t) = eta_bracket(eta);
+        McTable::from_nodes(eta, &node_values(data, lo), &node_values(data, hi), t)
+    }
+
+    /// [`McTable::from_data`] of the embedded file, parsed again (a cold start: what the first
+    /// `mc-table` model of a process costs, for timing); all zeros if it cannot be read.
+    pub fn from_embedded_uncached(eta: f64) -> McTable {
+        match McTableData::from_bytes(EMBEDDED) {
+            Ok(data) => McTable::from_data(&data, eta),
+            Err(_) => McTable::from_nodes(clamp_eta(eta), &[], &[], 0.0),
+        }
+    }
+
+    /// The table through knot values `(1 − t) a + t b` (all zeros when `a` or `b` is not a
+    /// full table).
+    fn from_nodes(eta: f64, a: &[f64], b: &[f64], t: f64) -> McTable {
+        let rho_samples = rho_samples();
+        let radius_samples = spline_knots(&radius_knots());
+        let n = radius_samples.len();
+        let mut profile = vec![0.0; N_RHO * n];
+        if a.len() == profile.len() && b.len() == profile.len() {
+            for (p, (a, b)) in profile.iter_mut().zip(a.iter().zip(b)) {
+                *p = if t == 0.0 {
+                    *a
+                } else if t == 1.0 {
+                    *b
+                } else {
+                    (1.0 - t) * a + t * b
+                };
+            }
+        }
+        let mut profile_cdf = Vec::with_capacity(profile.len());
+        let mut rho_eff = Vec::with_capacity(N_RHO);
+        for row in profile.chunks_exact(n) {
+            let (total, cdf) = integrate_catmull_rom(&radius_samples, row);
+            profile_cdf.extend(cdf);
+            rho_eff.push(total);
+        }
+        let index = KnotIndex::new(&radius_samples).expect("the radius knots are increasing");
+        McTable {
+            eta,
+            rho_samples,
+            radius_samples,
+            profile,
+            profile_cdf,
+            rho_eff,
+            index,
+        }
+    }
+
+    /// The table for `eta` from a process-wide cache keyed by the clamped η's bits, built on
+    /// first use. Every call with the same η returns the same `Arc`.
+    pub fn shared(eta: f64) -> Arc<McTable> {
+        type Cache = Mutex<HashMap<u64, Arc<McTable>>>;
+        static CACHE: OnceLock<Cache> = OnceLock::new();
+        let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
+        let key = clamp_eta(eta).to_bits();
+        if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+            return Arc::clone(t);
+        }
+        let table = Arc::new(McTable::new(eta));
+        let mut map = cache.lock().unwrap_or_else(|e| e.into_inner());
+        Arc::clone(map.entry(key).or_insert(table))
+    }
+
+    /// The η of the table (clamped to [`ETAS`]' range).
+    pub fn eta(&self) -> f64 {
+        self.eta
+    }
+
+    /// The albedo rows ρ_i.
+    pub fn rho_samples(&self) -> &[f64] {
+        &self.rho_samples
+    }
+
+    /// The optical radius knots of the splines (mean free paths 1/σ_t; [`spline_knots`]).
+    pub fn radius_samples(&self) -> &[f64] {
+        &self.radius_samples
+    }
+
+    /// Largest tabulated optical radius; the profile is 0 beyond it.
+    pub fn max_optical_radius(&self) -> f64 {
+        self.radius_samples[self.radius_samples.len() - 1]
+    }
+
+    /// The value T = 2πx R_d¹(x) at albedo row `i`, knot `j`.
+    pub fn profile(&self, i: usize, j: usize) -> f64 {
+        self.profile[i * self.radius_samples.len() + j]
+    }
+
+    /// Row-major [`N_RHO`] × knots array of all profile values.
+    pub fn profile_values(&self) -> &[f64] {
+        &self.profile
+    }
+
+    /// Row-major running integrals of the profile splines.
+    pub fn profile_cdf_values(&self) -> &[f64] {
+        &self.profile_cdf
+    }
+
+    /// The effective albedo ρ_eff (integral of the spline) of every albedo row.
+    pub fn rho_eff_samples(&self) -> &[f64] {
+        &self.rho_eff
+    }
+
+    /// Spline-interpolated effective albedo, unclamped; 0 outside [0, 1].
+    fn effective_albedo_raw(&self, rho: f64) -> f64 {
+        match catmull_rom_weights(&self.rho_samples, rho) {
+            Some((offset, w)) => apply_weights(offset, &w, |i| self.rho_eff[i]),
+            None => 0.0,
+        }
+    }
+
+    /// The total diffuse reflectance of albedo `rho` (Catmull-Rom over the rows' ρ_eff),
+    /// clamped to [0, 1]; 0 outside [0, 1].
+    pub fn effective_albedo(&self, rho: f64) -> f64 {
+        let v = self.effective_albedo_raw(rho);
+        if v.is_finite() {
+            v.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Tensor-product spline interpolation of T at albedo `rho` and optical radius
+    /// `r_optical`, or `None` outside the table.
+    pub fn interpolate_profile(&self, rho: f64, r_optical: f64) -> Option<f64> {
+        let (ro, rw) = catmull_rom_weights(&self.rho_samples, rho)?;
+        let n = self.radius_samples.len();
+        let (co, cw) = catmull_rom_weights(&self.radius_samples, r_optical)?;
+        Some(apply_weights(ro, &rw, |i| {
+            apply_weights(co, &cw, |j| self.profile[i * n + j])
+        }))
+    }
+
+    /// The spline of albedo row `i` at optical radius `x` (`None` outside the knots).
+    pub fn row_spline(&self, i: usize, x: f64) -> Option<f64> {
+        let n = self.radius_samples.len();
+        interpolate_catmull_rom(&self.radius_samples, &self.profile[i * n..(i + 1) * n], x)
+    }
+}
+
+/// The two tables of [`ETAS`] around `eta` (already clamped) and the weight of the upper one.
+fn eta_bracket(eta: f64) -> (usize, usize, f64) {
+    let hi = ETAS.partition_point(|&e| e <= eta).clamp(1, ETAS.len() - 1);
+    let (e0, e1) = (ETAS[hi - 1], ETAS[hi]);
+    (hi - 1, hi, ((eta - e0) / (e1 - e0)).clamp(0.0, 1.0))
+}
+
+/// η clamped to the range of [`ETAS`] (NaN to [`MAIN_ETA`]).
+fn clamp_eta(eta: f64) -> f64 {
+    if eta.is_nan() {
+        MAIN_ETA
+    } else {
+        eta.clamp(ETAS[0], ETAS[ETAS.len() - 1])
+    }
+}
+
+/// True when `eta` lies in the range of [`ETAS`], where the tables are interpolated rather
+/// than clamped.
+pub fn eta_in_range(eta: f64) -> bool {
+    (ETAS[0]..=ETAS[ETAS.len() - 1]).contains(&eta)
+}
+
+/// The `mc-table` model for one [`Medium`]: the random walk's profile from the shared
+/// [`McTable`] of its η, scaled to its reduced extinction.
+///
+/// - With σ'_t = σ_a + σ_s(1 − g) and ρ' = σ_s(1 − g)/σ'_t (the similarity relation, see the
+///   module documentation), [`Bssrdf::rd`] is σ'_t² times the table row blended at ρ',
+///   evaluated at x = rσ'_t and divided by 2πx, clamped to ≥ 0, and 0 beyond the table's
+///   last knot. The row's first interval [0, 0.0005] is linear in 2πx R_d
+///   ([`SplineRow::with_linear_first_segment`]): R_d is constant there instead of bumping.
+/// - [`Bssrdf::total_diffuse_reflectance`] is the row's integral (the interpolated effective
+///   albedo up to that first interval, ≈ 10⁻⁵ of it), clamped to [0, 1].
+/// - [`Bssrdf::sample_sr`] inverts the CDF of the non-negative row
+///   ([`SplineRow::non_negative`]) and [`Bssrdf::pdf_sr`] is its exact density, as for
+///   [`crate::PhotonBeamDiffusion`]; a channel without tabulated mass (ρ' = 0) samples
+///   σ'_t e^{−σ'_t r}.
+#[derive(Clone, Debug)]
+pub struct McTableModel {
+    medium: Medium,
+    table: Arc<McTable>,
+    rho: Rgb,
+    sigma_t: Rgb,
+    rows: [Option<SplineRow>; 3],
+    sampling: [Option<SplineRow>; 3],
+}
+
+impl McTableModel {
+    /// The model for `medium`, sharing the table of its η with every other medium.
+    pub fn new(medium: Medium) -> Self {
+        let table = McTable::shared(medium.eta());
+        let sigma_t: Rgb = std::array::from_fn(|ch| medium.sigma_t_reduced(ch));
+        let rho: Rgb = std::array::from_fn(|ch| {
+            let st = sigma_t[ch];
+            let v = medium.sigma_s_reduced(ch) / st;
+            if v.is_finite() {
+                v.clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        });
+        let rows = std::array::from_fn(|ch| {
+            SplineRow::blend(
+                &table.index,
+                &table.rho_samples,
+                &table.profile,
+                &table.profile_cdf,
+                rho[ch],
+            )
+            .map(|row| row.with_linear_first_segment())
+        });
+        let sampling = std::array::from_fn(|ch| {
+            rows[ch]
+                .as_ref()
+                .map(SplineRow::non_negative)
+                .filter(|row| row.total() > 0.0 && row.total().is_finite())
+        });
+        McTableModel {
+            medium,
+            table,
+            rho,
+            sigma_t,
+            rows,
+            sampling,
+        }
+    }
+
+    /// The shared table behind this model.
+    pub fn table(&self) -> &McTable {
+        &self.table
+    }
+
+    /// The reduced albedo ρ' of channel `ch` at which the table is read.
+    pub fn reduced_albedo(&self, ch: usize) -> f64 {
+        self.rho[ch]
+    }
+
+    /// The effective albedo (total diffuse reflectance) of channel `ch`: the integral of the
+    /// channel's row (the table's ρ_eff interpolated at ρ', with the first interval linear),
+    /// clamped to [0, 1].
+    pub fn effective_albedo(&self, ch: usize) -> f64 {
+        let v = self.rows[ch].as_ref().map_or(0.0, SplineRow::total);
+        if v.is_finite() {
+            v.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// True when the medium's η lies in [1.0, 1.5], the range of [`ETAS`]; otherwise the
+    /// nearest end table was used.
+    pub fn eta_in_range(&self) -> bool {
+        eta_in_range(self.medium.eta())
+    }
+
+    fn fallback_pdf(&self, ch: usize, r: f64) -> f64 {
+        let st = self.sigma_t[ch];
+        let v = st * (-st * r).exp();
+        if v.is_finite() { v } else { 0.0 }
+    }
+}
+
+impl Bssrdf for McTableModel {
+    fn kind(&self) -> ModelKind {
+        ModelKind::McTable
+    }
+
+    fn medium(&self) -> &Medium {
+        &self.medium
+    }
+
+    fn rd(&self, ch: usize, r: f64) -> f64 {
+        if !(r >= 0.0) || !r.is_finite() {
+            return 0.0;
+        }
+        let st = self.sigma_t[ch];
+        let Some(row) = &self.rows[ch] else {
+            return 0.0;
+        };
+        let v = row.eval_over_x(r * st) * (st * st / (2.0 * PI));
+        if v.is_finite() { v.max(0.0) } else { 0.0 }
+    }
+
+    fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
+        self.effective_albedo(ch)
+    }
+
+    fn sample_sr(&self, ch: usize, u: f64) -> f64 {
+        let u = if u.is_finite() {
+            u.clamp(0.0, 1.0 - f64::EPSILON)
+        } else {
+            0.0
+        };
+        let st = self.sigma_t[ch];
+        let Some(row) = &self.sampling[ch] else {
+            let r = -(-u).ln_1p() / st;
+            return if r.is_finite() { r.max(0.0) } else { 0.0 };
+        };
+        let r = row.sample(u).unwrap_or(0.0) / st;
+        if r.is_finite() { r.max(0.0) } else { 0.0 }
+    }
+
+    fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
+        if !(r >= 0.0) || !r.is_finite() {
+            return 0.0;
+        }
+        let Some(row) = &self.sampling[ch] else {
+            return self.fallback_pdf(ch, r);
+        };
+        let st = self.sigma_t[ch];
+        let v = row.eval(r * st).max(0.0) * st / row.total();
+        if v.is_finite() { v } else { 0.0 }
+    }
+
+    /// Inverts the row's CDF, as [`Bssrdf::sample_sr`].
+    fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64 {
+        self.sample_sr(ch, fraction)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quadrature::integrate;
+
+    /// ∫ x e^{−ax} dx from 0 to x.
+    fn xexp_integral(a: f64, x: f64) -> f64 {
+        (1.0 - (-a * x).exp() * (a * x + 1.0)) / (a * a)
+    }
+
+    /// A smooth test profile T(x) = x e^{−0.7x} + 0.3 x e^{−3x} and its bin integrals.
+    fn synthetic(x: f64) -> f64 {
+        x * (-0.7 * x).exp() + 0.3 * x * (-3.0 * x).exp()
+    }
+
+    fn synthetic_bin(lo: f64, hi: f64) -> f64 {
+        let f = |x| xexp_integral(0.7, x) + 0.3 * xexp_integral(3.0, x);
+        f(hi) - f(lo)
+    }
+
+    /// ∫ of the spline through `values` over [lo, hi] (exact: Gauss-Legendre per knot piece).
+    fn spline_integral(knots: &[f64], values: &[f64], lo: f64, hi: f64) -> f64 {
+        let mut cuts = vec![lo];
+        cuts.extend(knots.iter().copied().filter(|&x| x > lo && x < hi));
+        cuts.push(hi);
+        cuts.windows(2)
+            .map(|w| {
+                integrate(
+                    &|x| interpolate_catmull_rom(knots, values, x).unwrap(),
+                    w[0],
+                    w[1],
+                    4,
+                )
+            })
+            .sum()
+    }
+
+    #[test]
+    fn grids_are_as_documented() {
+        let rho = rho_samples();
+        assert_eq!((rho.len(), rho[0], rho[N_RHO - 1]), (N_RHO, 0.0, 1.0));
+        let x = radius_knots();
+        assert_eq!((x[0], x[1]), (0.0, FIRST_KNOT));
+        assert!(x.len() >= 80 && x.len() <= 90, "{}", x.len());
+        let last = x[x.len() - 1];
+        assert!(last > 900.0 && last <= LAST_KNOT_LIMIT, "{last}");
+        for w in x[1..].windows(2) {
+            let step = w[1] - w[0];
+            // Geometric (20 %) near 0, never more than 0.75 on [4, 16], geometric again
+            // beyond.
+            assert!(step <= 0.2 * w[0] * (1.0 + 1e-12), "{w:?}");
+            if w[0] >= 4.0 && w[0] < LINEAR_END {
+                assert!((step - LINEAR_STEP).abs() < 1e-12, "{w:?}");
+            }
+        }
+        let edges = tally_edges(&x);
+        assert_eq!(edges.len(), x.len() + 1);
+        assert_eq!((edges[1], edges[edges.len() - 1]), (x[1], last));
+        for k in 2..x.len() {
+            assert!(edges[k] < x[k] && x[k] < edges[k + 1] || k == x.len() - 1);
+        }
+        // Bands cover every row once; each η has its own streams.
+        let p13 = plan(3, 1.0);
+        let p10 = plan(0, 1.0);
+        let mut covered = vec![0; N_RHO];
+        for w in p13.iter().filter(|w| w.min_events == 1) {
+            for i in w.rows.clone() {
+                covered[i] += 1;
+            }
+        }
+        assert!(covered.iter().all(|&c| c == 1), "{covered:?}");
+        assert!(p13.iter().zip(&p10).all(|(a, b)| a.stream != b.stream));
+        assert!(
+            p13.iter()
+                .zip(&p10)
+                .all(|(a, b)| a.photons == OTHER_ETA_PHOTON_DIVISOR * b.photons)
+        );
+    }
+
+    #[test]
+    fn histopolation_reproduces_bin_integrals_and_point_values() {
+        let knots = radius_knots();
+        let xs = spline_knots(&knots);
+        assert_eq!(xs.len(), knots.len() + 1);
+        let edges = tally_edges(&knots);
+        let system = Histopolation::new(&knots).unwrap();
+        let masses: Vec<f64> = edges
+            .windows(2)
+            .map(|e| synthetic_bin(e[0], e[1]))
+            .collect();
+        let v = system.solve(&masses);
+        let mut values = vec![0.0];
+        values.extend(&v);
+        // Every bin integrates to its mass.
+        for k in 0..knots.len() {
+            let got = spline_integral(&xs, &values, edges[k], edges[k + 1]);
+            assert!(
+                // (The masses far out are differences of O(1) values: 10⁻¹⁵ absolute.)
+                (got - masses[k]).abs() <= 1e-10 * masses[k] + 1e-14,
+                "bin {k}: {got} vs {}",
+                masses[k]
+            );
+        }
+        // The knot values are the point values of the profile (not its bin averages, which
+        // are several % off where the bins are wide), over the accuracy range (up to 16 mean
+        // free paths; beyond, the steps grow and this profile's decay of 0.7 per unit makes the
+        // spline a few % off between knots).
+        let mut worst_avg: f64 = 0.0;
+        for j in 1..xs.len() {
+            let want = synthetic(xs[j]);
+            // (2 % at the extra knot, whose first interval must start at 0.)
+            let tol = if j == 1 { 0.02 } else { 0.01 };
+            if xs[j] <= 16.0 {
+                assert!(
+                    (values[j] - want).abs() < tol * want,
+                    "x {}: {} vs {want}",
+                    xs[j],
+                    values[j]
+                );
+            }
+            if j >= 2 && xs[j] <= 16.0 {
+                let k = j - 1;
+                let avg = masses[k] / (edges[k + 1] - edges[k]);
+                worst_avg = worst_avg.max((avg / want - 1.0).abs());
+            }
+        }
+        assert!(
+            worst_avg > 0.03,
+            "bin averages happen to be point values: {worst_avg}"
+        );
+    }
+
+    #[test]
+    fn isotonic_fit_pools_adjacent_violators() {
+        assert_eq!(
+            non_increasing_fit(&[5.0, 3.0, 4.0, 1.0], &[1.0; 4]),
+            vec![5.0, 3.5, 3.5, 1.0]
+        );
+        assert_eq!(
+            non_increasing_fit(&[1.0, 2.0], &[3.0, 1.0]),
+            vec![1.25, 1.25]
+        );
+        // Already ordered: unchanged; a long violation pools across blocks.
+        let y = [9.0, 7.0, 7.0, 2.0];
+        assert_eq!(non_increasing_fit(&y, &[1.0; 4]), y.to_vec());
+        assert_eq!(
+            non_increasing_fit(&[3.0, 1.0, 2.0, 6.0], &[1.0; 4]),
+            vec![3.0, 3.0, 3.0, 3.0]
+        );
+    }
+
+    #[test]
+    fn unresolved_tail_keeps_its_mass_in_the_fitted_shape() {
+        let knots = radius_knots();
+        let edges = tally_edges(&knots);
+        let exact: Vec<f64> = edges
+            .windows(2)
+            .map(|e| ((-0.5 * e[0]).exp() - (-0.5 * e[1]).exp()) / 0.5)
+            .collect();
+        let se: Vec<f64> = exact.iter().map(|m| 0.01 * m).collect();
+        // The tally beyond r = 10 is noise: zeros and single hits (relative standard error
+        // 1), too few to pool into resolved groups. Their total is kept, spread like the
+        // exponential of the resolved bins (κ = 0.5 recovered exactly).
+        let mut noisy = exact.clone();
+        let mut noisy_se = se.clone();
+        let first_bad = edges.partition_point(|&e| e < 10.0);
+        for k in first_bad..noisy.len() {
+            noisy[k] = if k % 3 == 0 { 5.0 * exact[k] } else { 0.0 };
+            noisy_se[k] = noisy[k];
+        }
+        let (tail, last) = tail_masses(&edges, &noisy, &noisy_se);
+        assert_eq!(last, first_bad - 1);
+        assert_eq!(tail[..first_bad], exact[..first_bad]);
+        let ratio = noisy[first_bad..].iter().sum::<f64>() / exact[first_bad..].iter().sum::<f64>();
+        assert!(ratio > 1.0);
+        for k in first_bad..exact.len() {
+            assert!(
+                (tail[k] - ratio * exact[k]).abs() <= 1e-9 * ratio * exact[k] + 1e-300,
+                "bin {k}: {} vs {}",
+                tail[k],
+                ratio * exact[k]
+            );
+        }
+        // A tail that does not decay where it is resolved (here it rises slowly from x = 6 to
+        // the last resolved bin) is spread like 1/x² instead.
+        let rising: Vec<f64> = edges
+            .windows(2)
+            .map(|e| {
+                let c = 0.5 * (e[0] + e[1]);
+                let d = if c < 6.0 {
+                    (-0.5 * c).exp()
+                } else if c < 12.0 {
+                    (-3.0f64).exp() * (1.0 + 0.01 * (c - 6.0))
+                } else {
+                    (-3.0 - (c - 12.0)).exp()
+                };
+                d * (e[1] - e[0])
+            })
+            .collect();
+        let rising_se: Vec<f64> = rising
+            .iter()
+            .zip(&edges)
+            .map(|(m, &lo)| if lo < 10.0 { 0.01 * m } else { *m })
+            .collect();
+        let (spread, last) = tail_masses(&edges, &rising, &rising_se);
+        assert_eq!(last, first_bad - 1);
+        assert_eq!(spread[..first_bad], rising[..first_bad]);
+        let rest: f64 = rising[first_bad..].iter().sum();
+        let x0 = edges[first_bad];
+        let end = edges[edges.len() - 1];
+        for k in first_bad..rising.len() {
+            let want = rest * (1.0 / edges[k] - 1.0 / edges[k + 1]) / (1.0 / x0 - 1.0 / end);
+            assert!((spread[k] - want).abs() <= 1e-9 * want, "bin {k}");
+        }
+    }
+
+    #[test]
+    fn poorly_resolved_tail_bins_are_pooled_keeping_their_mass() {
+        // A power-law tail (as at albedo 1) whose bins beyond x = 20 each have a relative
+        // standard error of 30 %, with ±30 % noise: pooled in resolved groups, each group keeps
+        // its tallied mass and the density becomes smooth (non-increasing) inside it.
+        let knots = radius_knots();
+        let edges = tally_edges(&knots);
+        let density = |x: f64| 1.0 / (1.0 + x * x);
+        let exact: Vec<f64> = edges
+            .windows(2)
+            .map(|e| (e[1].atan() - e[0].atan()) / 1.0)
+            .collect();
+        let first_bad = edges.partition_point(|&e| e < 20.0);
+        let mut mass = exact.clone();
+        let mut se: Vec<f64> = exact.iter().map(|m| 0.01 * m).collect();
+        for k in first_bad..mass.len() - 3 {
+            mass[k] = exact[k] * if k % 2 == 0 { 1.3 } else { 0.7 };
+            se[k] = 0.3 * mass[k];
+        }
+        let n = mass.len();
+        for k in n - 3..n {
+            mass[k] = 0.0;
+            se[k] = 0.0;
+        }
+        let (out, last) = tail_masses(&edges, &mass, &se);
+        assert_eq!(last, first_bad - 1);
+        // Groups are runs of two or three bins (0.3/√2 > 0.2 ≥ 0.3/√3); their sums are kept.
+        let mut k = first_bad;
+        let mut groups = 0;
+        while k + 3 <= n - 3 {
+            let kept: f64 = out[k..k + 3].iter().sum();
+            let tallied: f64 = mass[k..k + 3].iter().sum();
+            assert!((kept - tallied).abs() <= 1e-12 * tallied, "group at {k}");
+            groups += 1;
+            k += 3;
+        }
+        assert!(groups >= 3, "{groups}");
+        // Within the pooled region the density falls from bin to bin, and stays within 30 %
+        // of the exact one (the groups' own noise is ±10 %; the shape extrapolated at the
+        // end of the last group adds the rest).
+        for k in first_bad..k {
+            let d = out[k] / (edges[k + 1] - edges[k]);
+            let c = 0.5 * (edges[k] + edges[k + 1]);
+            assert!(
+                (d / density(c) - 1.0).abs() < 0.3,
+                "bin {k}: {d} vs {}",
+                density(c)
+            );
+            if k > first_bad {
+                let prev = out[k - 1] / (edges[k] - edges[k - 1]);
+                assert!(d <= prev * (1.0 + 1e-12), "bin {k} rises");
+            }
+        }
+        assert!(out.iter().all(|v| v.is_finite() && *v >= 0.0));
+    }
+
+    #[test]
+    fn table_file_round_trips_and_rejects_damage() {
+        let quiet = |_: &str| {};
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| McTableData::generate(2e-5, &quiet).unwrap())
+        };
+        let data = run(2);
+        let bytes = data.to_bytes();
+        // The same bytes for any thread count, and a faithful round trip.
+        assert_eq!(run(1).to_bytes(), bytes);
+        let back = McTableData::from_bytes(&bytes).unwrap();
+        assert_eq!(back, data);
+        assert_eq!(back.to_bytes(), bytes);
+        // Any damage is an error, never a panic.
+        for at in [0, 9, 40, bytes.len() / 2, bytes.len() - 1] {
+            let mut bad = bytes.clone();
+            bad[at] ^= 0x10;
+            assert!(McTableData::from_bytes(&bad).is_err(), "flip at {at}");
+        }
+        for len in [0, 7, 16, 100, bytes.len() - 8, bytes.len() - 1] {
+            assert!(
+                McTableData::from_bytes(&bytes[..len]).is_err(),
+                "length {len}"
+            );
+        }
+        // A well-formed file of other grids is refused.
+        let mut other = data.clone();
+        other.knots[5] *= 1.0 + 1e-12;
+        let err = McTableData::from_bytes(&other.to_bytes()).unwrap_err();
+        assert!(err.to_string().contains("grids differ"), "{err}");
+        assert!(McTableData::generate(0.0, &quiet).is_err());
+    }
+
+    #[test]
+    fn embedded_table_is_read() {
+        let data = McTableData::embedded().unwrap();
+        assert_eq!(data.etas(), ETAS);
+        assert_eq!(data.seed(), SEED);
+        for e in 0..ETAS.len() {
+            assert_eq!(data.walks(e), plan(e, 1.0).as_slice(), "eta index {e}");
+        }
+    }
+
+    #[test]
+    fn eta_between_tables_is_linear_and_clamped_outside() {
+        let (a, b, mid) = (McTable::new(1.3), McTable::new(1.4), McTable::new(1.35));
+        for ((p, q), m) in a
+            .profile_values()
+            .iter()
+            .zip(b.profile_values())
+            .zip(mid.profile_values())
+        {
+            assert!((m - 0.5 * (p + q)).abs() <= 1e-14 * (p + q) + 1e-300);
+        }
+        assert_eq!(
+            McTable::new(2.5).profile_values(),
+            McTable::new(1.5).profile_values()
+        );
+        assert_eq!(
+            McTable::new(0.7).profile_values(),
+            McTable::new(1.0).profile_values()
+        );
+        for (eta, inside) in [
+            (1.0, true),
+            (1.5, true),
+            (1.33, true),
+            (0.99, false),
+            (1.51, false),
+        ] {
+            assert_eq!(eta_in_range(eta), inside, "{eta}");
+        }
+        assert!(!eta_in_range(f64::NAN));
+        // The uncached build is the cached one.
+        assert_eq!(
+            McTable::from_embedded_uncached(1.35).profile_values(),
+            mid.profile_values()
+        );
+    }
+
+    #[test]
+    fn anisotropic_media_use_their_reduced_coefficients() {
+        // σ_s = 2, g = 0.5 has σ'_s = 1: the same model as σ_s = 1, g = 0.
+        let a = Medium::new([0.1, 0.3, 0.0], [2.0, 4.0, 6.0], 0.5, 1.3).unwrap();
+        let b = Medium::new([0.1, 0.3, 0.0], [1.0, 2.0, 3.0], 0.0, 1.3).unwrap();
+        let (ma, mb) = (McTableModel::new(a), McTableModel::new(b));
+        for ch in 0..3 {
+            assert_eq!(ma.reduced_albedo(ch), mb.reduced_albedo(ch));
+            for r in [0.0, 0.01, 0.3, 2.0, 40.0] {
+                assert_eq!(ma.rd(ch, r), mb.rd(ch, r));
+                assert_eq!(ma.pdf_sr(ch, r), mb.pdf_sr(ch, r));
+            }
+            assert_eq!(ma.sample_sr(ch, 0.4), mb.sample_sr(ch, 0.4));
+        }
+        assert!(ma.eta_in_range());
+        let out = Medium::new([0.1; 3], [1.0; 3], 0.0, 1.7).unwrap();
+        assert!(!McTableModel::new(out).eta_in_range());
+    }
+}
