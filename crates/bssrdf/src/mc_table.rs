@@ -72,7 +72,7 @@ use crate::catmull_rom::{
 use crate::monte_carlo::MAX_SCATTERING_EVENTS;
 use crate::monte_carlo::condensed::{CondensedConfig, simulate_albedos};
 use crate::quadrature::gauss_legendre;
-use crate::spline_row::{KnotIndex, SplineRow};
+use crate::spline_row::{KnotIndex, OpticalProfile, SplineRow};
 use crate::{Bssrdf, BssrdfError, Medium, ModelKind, Rgb};
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -1377,9 +1377,7 @@ pub struct McTableModel {
     medium: Medium,
     table: Arc<McTable>,
     rho: Rgb,
-    sigma_t: Rgb,
-    rows: [Option<SplineRow>; 3],
-    sampling: [Option<SplineRow>; 3],
+    profile: OpticalProfile,
 }
 
 impl McTableModel {
@@ -1406,19 +1404,11 @@ impl McTableModel {
             )
             .map(|row| row.with_linear_first_segment())
         });
-        let sampling = std::array::from_fn(|ch| {
-            rows[ch]
-                .as_ref()
-                .map(SplineRow::non_negative)
-                .filter(|row| row.total() > 0.0 && row.total().is_finite())
-        });
         McTableModel {
             medium,
             table,
             rho,
-            sigma_t,
-            rows,
-            sampling,
+            profile: OpticalProfile::new(sigma_t, rows),
         }
     }
 
@@ -1436,7 +1426,7 @@ impl McTableModel {
     /// channel's row (the table's ρ_eff interpolated at ρ', with the first interval linear),
     /// clamped to [0, 1].
     pub fn effective_albedo(&self, ch: usize) -> f64 {
-        let v = self.rows[ch].as_ref().map_or(0.0, SplineRow::total);
+        let v = self.profile.rows[ch].as_ref().map_or(0.0, SplineRow::total);
         if v.is_finite() {
             v.clamp(0.0, 1.0)
         } else {
@@ -1448,12 +1438,6 @@ impl McTableModel {
     /// nearest end table was used.
     pub fn eta_in_range(&self) -> bool {
         eta_in_range(self.medium.eta())
-    }
-
-    fn fallback_pdf(&self, ch: usize, r: f64) -> f64 {
-        let st = self.sigma_t[ch];
-        let v = st * (-st * r).exp();
-        if v.is_finite() { v } else { 0.0 }
     }
 }
 
@@ -1467,15 +1451,7 @@ impl Bssrdf for McTableModel {
     }
 
     fn rd(&self, ch: usize, r: f64) -> f64 {
-        if !(r >= 0.0) || !r.is_finite() {
-            return 0.0;
-        }
-        let st = self.sigma_t[ch];
-        let Some(row) = &self.rows[ch] else {
-            return 0.0;
-        };
-        let v = row.eval_over_x(r * st) * (st * st / (2.0 * PI));
-        if v.is_finite() { v.max(0.0) } else { 0.0 }
+        self.profile.rd(ch, r)
     }
 
     fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
@@ -1483,30 +1459,11 @@ impl Bssrdf for McTableModel {
     }
 
     fn sample_sr(&self, ch: usize, u: f64) -> f64 {
-        let u = if u.is_finite() {
-            u.clamp(0.0, 1.0 - f64::EPSILON)
-        } else {
-            0.0
-        };
-        let st = self.sigma_t[ch];
-        let Some(row) = &self.sampling[ch] else {
-            let r = -(-u).ln_1p() / st;
-            return if r.is_finite() { r.max(0.0) } else { 0.0 };
-        };
-        let r = row.sample(u).unwrap_or(0.0) / st;
-        if r.is_finite() { r.max(0.0) } else { 0.0 }
+        self.profile.sample_sr(ch, u)
     }
 
     fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
-        if !(r >= 0.0) || !r.is_finite() {
-            return 0.0;
-        }
-        let Some(row) = &self.sampling[ch] else {
-            return self.fallback_pdf(ch, r);
-        };
-        let st = self.sigma_t[ch];
-        let v = row.eval(r * st).max(0.0) * st / row.total();
-        if v.is_finite() { v } else { 0.0 }
+        self.profile.pdf_sr(ch, r)
     }
 
     /// Inverts the row's CDF, as [`Bssrdf::sample_sr`].

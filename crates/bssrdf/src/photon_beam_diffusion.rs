@@ -18,7 +18,7 @@
 
 use crate::catmull_rom::{apply_weights, catmull_rom_weights, integrate_catmull_rom};
 use crate::fresnel::{fr_dielectric, fresnel_moment1, fresnel_moment2};
-use crate::spline_row::{KnotIndex, SplineRow};
+use crate::spline_row::{KnotIndex, OpticalProfile, SplineRow};
 use crate::{Bssrdf, Medium, ModelKind, Rgb};
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -355,13 +355,10 @@ pub struct PhotonBeamDiffusion {
     medium: Medium,
     table: Arc<PbdTable>,
     rho: Rgb,
-    sigma_t: Rgb,
-    /// Per channel, the table's rows blended at the channel's albedo: the same spline in
-    /// optical radius as the tensor interpolation, at table speed (see [`SplineRow`]).
-    rows: [Option<SplineRow>; 3],
-    /// Per channel, the blended row made non-negative ([`SplineRow::non_negative`]): the
-    /// distribution that `sample_sr` draws from and `pdf_sr` returns.
-    sampling: [Option<SplineRow>; 3],
+    /// Per channel, the table's rows blended at the channel's albedo (the same spline in
+    /// optical radius as the tensor interpolation, at table speed, see [`SplineRow`]), and
+    /// made non-negative for `sample_sr` and `pdf_sr`.
+    profile: OpticalProfile,
 }
 
 impl PhotonBeamDiffusion {
@@ -379,19 +376,11 @@ impl PhotonBeamDiffusion {
                 rho[ch],
             )
         });
-        let sampling = std::array::from_fn(|ch| {
-            rows[ch]
-                .as_ref()
-                .map(SplineRow::non_negative)
-                .filter(|row| row.total() > 0.0 && row.total().is_finite())
-        });
         PhotonBeamDiffusion {
             medium,
             table,
             rho,
-            sigma_t,
-            rows,
-            sampling,
+            profile: OpticalProfile::new(sigma_t, rows),
         }
     }
 
@@ -403,18 +392,6 @@ impl PhotonBeamDiffusion {
     /// The shared table behind this model.
     pub fn table(&self) -> &PbdTable {
         &self.table
-    }
-
-    /// True when channel `ch` samples the exponential fallback (no tabulated mass).
-    fn uses_fallback(&self, ch: usize) -> bool {
-        self.sampling[ch].is_none()
-    }
-
-    /// Exponential fallback density σ_t e^{−σ_t r}.
-    fn fallback_pdf(&self, ch: usize, r: f64) -> f64 {
-        let st = self.sigma_t[ch];
-        let v = st * (-st * r).exp();
-        if v.is_finite() { v } else { 0.0 }
     }
 }
 
@@ -428,15 +405,7 @@ impl Bssrdf for PhotonBeamDiffusion {
     }
 
     fn rd(&self, ch: usize, r: f64) -> f64 {
-        if !(r >= 0.0) || !r.is_finite() {
-            return 0.0;
-        }
-        let st = self.sigma_t[ch];
-        let Some(row) = &self.rows[ch] else {
-            return 0.0;
-        };
-        let v = row.eval_over_x(r * st) * (st * st / (2.0 * PI));
-        if v.is_finite() { v.max(0.0) } else { 0.0 }
+        self.profile.rd(ch, r)
     }
 
     fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
@@ -444,36 +413,11 @@ impl Bssrdf for PhotonBeamDiffusion {
     }
 
     fn sample_sr(&self, ch: usize, u: f64) -> f64 {
-        let u = if u.is_finite() {
-            u.clamp(0.0, 1.0 - f64::EPSILON)
-        } else {
-            0.0
-        };
-        let st = self.sigma_t[ch];
-        if self.uses_fallback(ch) {
-            return -(-u).ln_1p() / st;
-        }
-        let x = self.sampling[ch]
-            .as_ref()
-            .and_then(|row| row.sample(u))
-            .unwrap_or(0.0);
-        let r = x / st;
-        if r.is_finite() { r.max(0.0) } else { 0.0 }
+        self.profile.sample_sr(ch, u)
     }
 
     fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
-        if !(r >= 0.0) || !r.is_finite() {
-            return 0.0;
-        }
-        if self.uses_fallback(ch) {
-            return self.fallback_pdf(ch, r);
-        }
-        let st = self.sigma_t[ch];
-        let Some(row) = &self.sampling[ch] else {
-            return self.fallback_pdf(ch, r);
-        };
-        let v = row.eval(r * st).max(0.0) * st / row.total();
-        if v.is_finite() { v } else { 0.0 }
+        self.profile.pdf_sr(ch, r)
     }
 
     /// Inverts the interpolated row CDF: the same spline inversion as [`Bssrdf::sample_sr`]
