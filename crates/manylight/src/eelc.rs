@@ -203,14 +203,7 @@ impl<'a> Eelc<'a> {
 
     /// ΔI for J sampled strata and Σ s_j² under the configured interval.
     pub fn delta(&self, strata: usize, sum_s2: f64) -> f64 {
-        if strata == 0 {
-            return 0.0;
-        }
-        let v = match self.settings.interval {
-            Interval::Paper => sum_s2,
-            Interval::StandardError => 0.5 * sum_s2,
-        };
-        self.t.quantile(strata) * v.max(0.0).sqrt()
+        self.settings.interval.half_width(self.t, strata, sum_s2)
     }
 
     /// Estimates one pixel from its gather tree, a visibility test and the pixel's seed

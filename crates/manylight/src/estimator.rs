@@ -97,6 +97,21 @@ pub enum Interval {
     StandardError,
 }
 
+impl Interval {
+    /// ΔI for `strata` sampled strata of two samples each and Σ s_j² = `sum_s2`, with the
+    /// Student-t quantile `t` at ν = `strata` (0 without strata).
+    pub fn half_width(self, t: &StudentT, strata: usize, sum_s2: f64) -> f64 {
+        if strata == 0 {
+            return 0.0;
+        }
+        let v = match self {
+            Interval::Paper => sum_s2,
+            Interval::StandardError => 0.5 * sum_s2,
+        };
+        t.quantile(strata) * v.max(0.0).sqrt()
+    }
+}
+
 /// Per-pixel settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings {
@@ -375,14 +390,7 @@ impl<'a> Estimator<'a> {
 
     /// ΔI for J triplets and Σ s_j² under the configured interval.
     pub fn delta(&self, triplets: usize, sum_s2: f64) -> f64 {
-        if triplets == 0 {
-            return 0.0;
-        }
-        let v = match self.settings.interval {
-            Interval::Paper => sum_s2,
-            Interval::StandardError => 0.5 * sum_s2,
-        };
-        self.t.quantile(triplets) * v.max(0.0).sqrt()
+        self.settings.interval.half_width(self.t, triplets, sum_s2)
     }
 
     /// Estimates one pixel: the shading points of this object in the pixel, a visibility

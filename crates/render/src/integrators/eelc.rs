@@ -77,18 +77,8 @@ impl Default for Eelc {
 impl Eelc {
     /// The settings `options` describe (errors name the flag).
     pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
-        let eps: f64 = o.get(&OPTIONS, "eps")?;
-        if !(eps.is_finite() && eps >= 0.0) {
-            return Err(Error::Input(format!(
-                "--eps must be finite and ≥ 0, got {eps}"
-            )));
-        }
-        let alpha: f64 = o.get(&OPTIONS, "alpha")?;
-        if !(alpha > 0.0 && alpha < 1.0) {
-            return Err(Error::Input(format!(
-                "--alpha must be in (0, 1), got {alpha}"
-            )));
-        }
+        let eps = super::single_tree::eps_option(o, &OPTIONS)?;
+        let alpha = super::manylight::alpha_option(o, &OPTIONS)?;
         Ok(Eelc {
             eps,
             alpha,

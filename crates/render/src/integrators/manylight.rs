@@ -35,7 +35,7 @@
 //! **Not supported** (clear errors): the directional dipole (not radial) and pre-scatter
 //! textures (the estimator's irradiance has no texture factor).
 
-use super::single_tree::check_radial;
+use super::single_tree::{check_radial, eps_option};
 use super::{
     Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
 };
@@ -173,6 +173,17 @@ impl Default for ManyLight {
     }
 }
 
+/// Reads and checks the confidence level α (in (0, 1)); shared with `eelc`.
+pub(crate) fn alpha_option(o: &MethodOptions, options: &[OptionSpec]) -> Result<f64, Error> {
+    let alpha: f64 = o.get(options, "alpha")?;
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(Error::Input(format!(
+            "--alpha must be in (0, 1), got {alpha}"
+        )));
+    }
+    Ok(alpha)
+}
+
 /// Parses `--selection`.
 pub fn parse_selection(s: &str) -> Result<Selection, Error> {
     match s.trim() {
@@ -187,18 +198,8 @@ pub fn parse_selection(s: &str) -> Result<Selection, Error> {
 impl ManyLight {
     /// The settings `options` describe (errors name the flag).
     pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
-        let eps: f64 = o.get(&OPTIONS, "eps")?;
-        if !(eps.is_finite() && eps >= 0.0) {
-            return Err(Error::Input(format!(
-                "--eps must be finite and ≥ 0, got {eps}"
-            )));
-        }
-        let alpha: f64 = o.get(&OPTIONS, "alpha")?;
-        if !(alpha > 0.0 && alpha < 1.0) {
-            return Err(Error::Input(format!(
-                "--alpha must be in (0, 1), got {alpha}"
-            )));
-        }
+        let eps = eps_option(o, &OPTIONS)?;
+        let alpha = alpha_option(o, &OPTIONS)?;
         let selection = parse_selection(&o.get::<String>(&OPTIONS, "selection")?)?;
         let vpls: u32 = o.get(&OPTIONS, "vpls")?;
         if vpls == 0 {

@@ -79,12 +79,7 @@ impl Default for Mdlc {
 impl Mdlc {
     /// The settings `options` describe (errors name the flag).
     pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
-        let eps: f64 = o.get(&OPTIONS, "eps")?;
-        if !(eps.is_finite() && eps >= 0.0) {
-            return Err(Error::Input(format!(
-                "--eps must be finite and ≥ 0, got {eps}"
-            )));
-        }
+        let eps = super::single_tree::eps_option(o, &OPTIONS)?;
         Ok(Mdlc {
             eps,
             points: PointOptions::from_options(o, &OPTIONS)?,
