@@ -2,9 +2,14 @@
 //! 1920 × 1080 RGB f32 frame, against the memory-bound limit (copying the same buffers), the
 //! 6-Gaussian baseline (d'Eon et al. 2007, 12 passes) and the exact 2D convolution.
 //!
-//! Frame: one skin1 object (better dipole) filling the screen, 0.5 mm per pixel (a head and
-//! shoulders shot: the 99 % kernel radius, 14 mm, spans 28 pixels), a pore-like irradiance
-//! texture, a gentle depth ramp, default filter options (jitter within 10 % of the kernel).
+//! Frames: one skin1 object (better dipole) filling the screen, a pore-like irradiance texture,
+//! default filter options (jitter within 10 % of the kernel). The first frame (`1080p`) is at a
+//! constant 0.5 mm per pixel (a head and shoulders shot: the 99 % kernel radius, 14 mm, spans
+//! 28 pixels) with a gentle depth ramp; the second (`1080p-tilted`) is a surface whose
+//! footprint grows linearly from 0.3 mm per pixel at the left edge to 0.7 at the right (and by
+//! 0.05 down the frame), with depth growing along both axes, so every pixel's tap positions
+//! differ from its neighbours' (the depth ramp stays under the rejection threshold: the frame
+//! measures varying footprints, not silhouettes).
 //! Kernels: the pre-integrated kernel with 7 importance-sampled taps per pass; six Gaussians
 //! with 7 importance-sampled taps per pass each. The exact 2D convolution is far too slow at
 //! 1080p (N² taps per pixel), so it runs on a 256 × 256 crop with a 31 × 31 kernel grid, next
@@ -58,6 +63,20 @@ impl Frame {
             mask: &self.mask,
             mm_per_pixel: &self.mm_per_pixel,
         }
+    }
+}
+
+impl Frame {
+    /// The second frame: the same texture on a surface whose footprint grows across the frame.
+    fn tilted(width: usize, height: usize) -> Frame {
+        let mut f = Frame::new(width, height);
+        let (wf, hf) = (width.max(2) as f32 - 1.0, height.max(2) as f32 - 1.0);
+        for (i, (d, m)) in f.depth.iter_mut().zip(&mut f.mm_per_pixel).enumerate() {
+            let (x, y) = ((i % width) as f32, (i / width) as f32);
+            *m = 0.3 + 0.4 * x / wf + 0.05 * y / hf;
+            *d = 600.0 + 0.1 * x + 0.05 * y;
+        }
+        f
     }
 }
 
@@ -221,6 +240,169 @@ fn avx2(f: impl FnOnce()) {
     f()
 }
 
+/// The floor for what the pass must do per pixel: the plain blur with each pixel's own tap
+/// positions (offsets in mm divided by its `mm_per_pixel`, as the separable pass places them),
+/// two texels linearly interpolated per tap, borders clamped, but no silhouette tests, no
+/// jitter and no skip. Tap positions and texel indices of a row are computed first as flat
+/// lanes (vectorised), then each pixel sums its taps with 4-float texel reads.
+struct VarBlur {
+    offsets_mm: Vec<f32>,
+    weights: Vec<[f32; 4]>,
+}
+
+/// Per-thread scratch of [`VarBlur`]: per tap, the fractions and texel indices of a row.
+#[derive(Default)]
+struct VarLanes {
+    inv: Vec<f32>,
+    frac: Vec<Vec<f32>>,
+    j0: Vec<Vec<u32>>,
+    j1: Vec<Vec<u32>>,
+}
+
+/// Texel `j` of a flat RGB image as 4 floats (the 4th is the next texel's red, or 0).
+#[inline(always)]
+fn texel4(src: &[f32], j: u32) -> [f32; 4] {
+    let i = 3 * j as usize;
+    match src.get(i..i + 4) {
+        Some(s) => [s[0], s[1], s[2], s[3]],
+        None => [src[i], src[i + 1], src[i + 2], 0.0],
+    }
+}
+
+impl VarBlur {
+    fn new(kernel: &SeparableKernel) -> VarBlur {
+        let taps = &kernel.terms[0].horizontal.taps;
+        VarBlur {
+            offsets_mm: taps.iter().map(|t| t.offset_mm as f32).collect(),
+            weights: taps
+                .iter()
+                .map(|t| {
+                    [
+                        t.weight[0] as f32,
+                        t.weight[1] as f32,
+                        t.weight[2] as f32,
+                        0.0,
+                    ]
+                })
+                .collect(),
+        }
+    }
+
+    /// Row `y` of one pass (VERTICAL: along columns) of `src` into `out`.
+    #[inline(always)]
+    fn row<const VERTICAL: bool>(
+        &self,
+        f: &Frame,
+        src: &[f32],
+        out: &mut [f32],
+        y: usize,
+        s: &mut VarLanes,
+    ) {
+        let (w, h) = (f.width, f.height);
+        let lim = if VERTICAL { h - 1 } else { w - 1 } as i32;
+        let nt = self.offsets_mm.len();
+        s.inv.resize(w, 0.0);
+        s.frac.resize_with(nt, Vec::new);
+        s.j0.resize_with(nt, Vec::new);
+        s.j1.resize_with(nt, Vec::new);
+        for (i, &m) in s.inv.iter_mut().zip(&f.mm_per_pixel[y * w..(y + 1) * w]) {
+            *i = 1.0 / m;
+        }
+        for t in 0..nt {
+            let o_mm = self.offsets_mm[t];
+            let (fr, j0, j1) = (&mut s.frac[t], &mut s.j0[t], &mut s.j1[t]);
+            fr.resize(w, 0.0);
+            j0.resize(w, 0);
+            j1.resize(w, 0);
+            for x in 0..w {
+                let p = if VERTICAL { y } else { x } as f32 - o_mm * s.inv[x];
+                let p0 = p.floor();
+                fr[x] = p - p0;
+                let (k0, k1) = ((p0 as i32).clamp(0, lim), (p0 as i32 + 1).clamp(0, lim));
+                (j0[x], j1[x]) = if VERTICAL {
+                    ((k0 as usize * w + x) as u32, (k1 as usize * w + x) as u32)
+                } else {
+                    ((y * w + k0 as usize) as u32, (y * w + k1 as usize) as u32)
+                };
+            }
+        }
+        for (x, o) in out.chunks_exact_mut(3).enumerate() {
+            let mut acc = [0.0f32; 4];
+            for t in 0..nt {
+                let (a, b) = (texel4(src, s.j0[t][x]), texel4(src, s.j1[t][x]));
+                let (fr, wt) = (s.frac[t][x], &self.weights[t]);
+                for c in 0..4 {
+                    acc[c] += wt[c] * (a[c] + fr * (b[c] - a[c]));
+                }
+            }
+            o.copy_from_slice(&acc[..3]);
+        }
+    }
+
+    /// Horizontal pass into `tmp`, vertical pass into `out`, in the AVX2 build where the CPU
+    /// has it.
+    fn run(&self, f: &Frame, tmp: &mut [[f32; 3]], out: &mut [[f32; 3]]) {
+        let w = f.width;
+        let src = f.irradiance.as_flattened();
+        tmp.as_flattened_mut()
+            .par_chunks_mut(3 * w)
+            .enumerate()
+            .for_each_init(VarLanes::default, |s, (y, row)| {
+                dispatch(|| self.row::<false>(f, src, row, y, s))
+            });
+        let tmp = tmp.as_flattened();
+        out.as_flattened_mut()
+            .par_chunks_mut(3 * w)
+            .enumerate()
+            .for_each_init(VarLanes::default, |s, (y, row)| {
+                dispatch(|| self.row::<true>(f, tmp, row, y, s))
+            });
+    }
+
+    /// One pass at pixel (x, y) in f64, straight from the definition (for the self-check).
+    fn pass_f64(
+        &self,
+        f: &Frame,
+        img: &dyn Fn(usize, usize) -> [f64; 3],
+        x: usize,
+        y: usize,
+        vertical: bool,
+    ) -> [f64; 3] {
+        let (w, h) = (f.width, f.height);
+        let inv = 1.0 / f.mm_per_pixel[y * w + x] as f64;
+        let mut v = [0.0f64; 3];
+        for (&o, wt) in self.offsets_mm.iter().zip(&self.weights) {
+            let p = if vertical { y } else { x } as f64 - o as f64 * inv;
+            let (p0, fr) = (p.floor(), p - p.floor());
+            let lim = if vertical { h - 1 } else { w - 1 } as f64;
+            let (k0, k1) = (
+                p0.clamp(0.0, lim) as usize,
+                (p0 + 1.0).clamp(0.0, lim) as usize,
+            );
+            let (a, b) = if vertical {
+                (img(x, k0), img(x, k1))
+            } else {
+                (img(k0, y), img(k1, y))
+            };
+            for c in 0..3 {
+                v[c] += wt[c] as f64 * (a[c] + fr * (b[c] - a[c]));
+            }
+        }
+        v
+    }
+}
+
+/// Runs `f` in the AVX2 build where the CPU has it.
+#[inline(always)]
+fn dispatch(f: impl FnOnce()) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2, checked just above.
+        return unsafe { avx2(f) };
+    }
+    f()
+}
+
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -276,12 +458,57 @@ fn separable(c: &mut Criterion) {
             );
         }
     }
+    let tilted = Frame::tilted(1920, 1080);
+    // The variable-footprint floor computes what it claims: a few pixels of both frames
+    // against the two passes written out in f64.
+    let var = VarBlur::new(&pre7);
+    for f in [&frame, &tilted] {
+        var.run(f, &mut tmp, &mut out);
+        let w = f.width;
+        let src = |x: usize, y: usize| f.irradiance[y * w + x].map(f64::from);
+        let hpass = |x: usize, y: usize| var.pass_f64(f, &src, x, y, false);
+        for (x, y) in [(0, 0), (5, 700), (960, 540), (1919, 1079), (1000, 3)] {
+            let want = var.pass_f64(f, &hpass, x, y, true);
+            for c in 0..3 {
+                let got = out[y * w + x][c] as f64;
+                assert!(
+                    (got - want[c]).abs() <= 1e-4 * want[c].abs().max(1e-3),
+                    "variable-footprint floor ({x},{y}): {got} vs {}",
+                    want[c]
+                );
+            }
+        }
+    }
+    // How much of the tilted frame takes the row-chunked fast path (printed for the README).
+    let fast = screen_space::filter_into_with(
+        &tilted.input(),
+        &pre7,
+        &opts,
+        &mut scratch,
+        &mut out,
+        screen_space::Evaluation::Rows,
+    )
+    .expect("filter");
+    eprintln!(
+        "tilted frame: {:.1} % of pixel passes on the fast path",
+        100.0 * fast
+    );
     for (name, threads) in [
         ("plain-blur-7taps/1-thread", &one),
         ("plain-blur-7taps/2-threads", &two),
     ] {
         g.bench_function(name, |b| {
             b.iter(|| threads.install(|| plain.run(black_box(&frame), &mut tmp, &mut out)))
+        });
+    }
+    for (name, f, threads) in [
+        ("variable-footprint-floor/1-thread", &frame, &one),
+        ("variable-footprint-floor/2-threads", &frame, &two),
+        ("tilted/variable-footprint-floor/1-thread", &tilted, &one),
+        ("tilted/variable-footprint-floor/2-threads", &tilted, &two),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| threads.install(|| var.run(black_box(f), &mut tmp, &mut out)))
         });
     }
     g.bench_function("pre-integrated-7taps-per-pixel/2-threads", |b| {
@@ -299,17 +526,39 @@ fn separable(c: &mut Criterion) {
             })
         })
     });
-    for (name, kernel, threads) in [
-        ("pre-integrated-7taps/1-thread", &pre7, &one),
-        ("pre-integrated-7taps/2-threads", &pre7, &two),
-        ("6-gaussians-7taps/1-thread", &gauss6, &one),
-        ("6-gaussians-7taps/2-threads", &gauss6, &two),
+    g.bench_function("tilted/pre-integrated-7taps-per-pixel/2-threads", |b| {
+        b.iter(|| {
+            two.install(|| {
+                screen_space::filter_into_with(
+                    black_box(&tilted.input()),
+                    &pre7,
+                    &opts,
+                    &mut scratch,
+                    &mut out,
+                    screen_space::Evaluation::PerPixel,
+                )
+                .expect("filter")
+            })
+        })
+    });
+    for (name, f, kernel, threads) in [
+        ("pre-integrated-7taps/1-thread", &frame, &pre7, &one),
+        ("pre-integrated-7taps/2-threads", &frame, &pre7, &two),
+        ("tilted/pre-integrated-7taps/1-thread", &tilted, &pre7, &one),
+        (
+            "tilted/pre-integrated-7taps/2-threads",
+            &tilted,
+            &pre7,
+            &two,
+        ),
+        ("6-gaussians-7taps/1-thread", &frame, &gauss6, &one),
+        ("6-gaussians-7taps/2-threads", &frame, &gauss6, &two),
     ] {
         g.bench_function(name, |b| {
             b.iter(|| {
                 threads.install(|| {
                     screen_space::filter_into(
-                        black_box(&frame.input()),
+                        black_box(&f.input()),
                         kernel,
                         &opts,
                         &mut scratch,
