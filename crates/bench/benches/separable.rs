@@ -213,60 +213,78 @@ impl PlainBlur {
         tmp.as_flattened_mut()
             .par_chunks_mut(3 * w)
             .enumerate()
-            .for_each(|(y, row)| self.dispatch(|| self.row_h(src, row, y, w)));
+            .for_each(|(y, row)| {
+                #[cfg(target_arch = "x86_64")]
+                if fast_build() {
+                    // SAFETY: the CPU has AVX2 and FMA (`fast_build`).
+                    return unsafe { fast::plain_h(self, src, row, y, w) };
+                }
+                self.row_h(src, row, y, w)
+            });
         let tmp = tmp.as_flattened();
         out.as_flattened_mut()
             .par_chunks_mut(3 * w)
             .enumerate()
-            .for_each(|(y, row)| self.dispatch(|| self.row_v(tmp, row, y, w, h)));
-    }
-
-    #[inline(always)]
-    fn dispatch(&self, f: impl FnOnce()) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2, checked just above.
-            return unsafe { avx2(f) };
-        }
-        f()
+            .for_each(|(y, row)| {
+                #[cfg(target_arch = "x86_64")]
+                if fast_build() {
+                    // SAFETY: the CPU has AVX2 and FMA (`fast_build`).
+                    return unsafe { fast::plain_v(self, tmp, row, y, (w, h)) };
+                }
+                self.row_v(tmp, row, y, w, h)
+            });
     }
 }
 
-/// Runs `f` (inlined) compiled for AVX2.
+/// Whether the CPU has AVX2 and FMA: the floors then run the rows compiled for them, as the
+/// pass under test does.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-fn avx2(f: impl FnOnce()) {
-    f()
+fn fast_build() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
+
+/// The floors' rows compiled for AVX2 and FMA (the row functions are inlined into these; a
+/// closure passed to a `target_feature` function is not reliably inlined, and then runs in
+/// the baseline build).
+#[cfg(target_arch = "x86_64")]
+mod fast {
+    use super::{Frame, PlainBlur, VarBlur};
+
+    #[target_feature(enable = "avx2,fma")]
+    pub fn plain_h(b: &PlainBlur, src: &[f32], out: &mut [f32], y: usize, w: usize) {
+        b.row_h(src, out, y, w)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    pub fn plain_v(b: &PlainBlur, src: &[f32], out: &mut [f32], y: usize, (w, h): (usize, usize)) {
+        b.row_v(src, out, y, w, h)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    pub fn var_row<const VERTICAL: bool>(
+        b: &VarBlur,
+        f: &Frame,
+        src: &[f32],
+        out: &mut [f32],
+        y: usize,
+    ) {
+        b.row::<VERTICAL>(f, src, out, y)
+    }
 }
 
 /// The floor for what the pass must do per pixel: the plain blur with each pixel's own tap
-/// positions (offsets in mm divided by its `mm_per_pixel`, as the separable pass places them),
-/// two texels linearly interpolated per tap, borders clamped, but no silhouette tests, no
-/// jitter and no skip. Tap positions and texel indices of a row are computed first as flat
-/// lanes (vectorised), then each pixel sums its taps with 4-float texel reads.
+/// positions (offsets in mm divided by its `mm_per_pixel`, in f32 as the separable pass places
+/// them), two texels linearly interpolated per tap, borders clamped, but no silhouette tests,
+/// no jitter and no skip. Written like [`PlainBlur`]: blocks of [`BLOCK`] pixels as flat f32
+/// runs with the sums in registers; per tap, the block's positions are computed per pixel and,
+/// where every pixel of the block has the same integer offset (the footprint changes slowly)
+/// and the reads stay inside the image, the tap is two contiguous runs blended per float;
+/// otherwise each pixel reads its two texels with the border clamp.
 struct VarBlur {
     offsets_mm: Vec<f32>,
-    weights: Vec<[f32; 4]>,
-}
-
-/// Per-thread scratch of [`VarBlur`]: per tap, the fractions and texel indices of a row.
-#[derive(Default)]
-struct VarLanes {
-    inv: Vec<f32>,
-    frac: Vec<Vec<f32>>,
-    j0: Vec<Vec<u32>>,
-    j1: Vec<Vec<u32>>,
-}
-
-/// Texel `j` of a flat RGB image as 4 floats (the 4th is the next texel's red, or 0).
-#[inline(always)]
-fn texel4(src: &[f32], j: u32) -> [f32; 4] {
-    let i = 3 * j as usize;
-    match src.get(i..i + 4) {
-        Some(s) => [s[0], s[1], s[2], s[3]],
-        None => [src[i], src[i + 1], src[i + 2], 0.0],
-    }
+    weights: Vec<[f32; 3]>,
+    /// Per tap, its RGB weights repeated over a block of [`BLOCK`] pixels.
+    lanes: Vec<[f32; 3 * BLOCK]>,
 }
 
 impl VarBlur {
@@ -274,68 +292,91 @@ impl VarBlur {
         let taps = &kernel.terms[0].horizontal.taps;
         VarBlur {
             offsets_mm: taps.iter().map(|t| t.offset_mm as f32).collect(),
-            weights: taps
+            weights: taps.iter().map(|t| t.weight.map(|w| w as f32)).collect(),
+            lanes: taps
                 .iter()
-                .map(|t| {
-                    [
-                        t.weight[0] as f32,
-                        t.weight[1] as f32,
-                        t.weight[2] as f32,
-                        0.0,
-                    ]
-                })
+                .map(|t| std::array::from_fn(|i| t.weight[i % 3] as f32))
                 .collect(),
         }
     }
 
     /// Row `y` of one pass (VERTICAL: along columns) of `src` into `out`.
     #[inline(always)]
-    fn row<const VERTICAL: bool>(
-        &self,
-        f: &Frame,
-        src: &[f32],
-        out: &mut [f32],
-        y: usize,
-        s: &mut VarLanes,
-    ) {
+    fn row<const VERTICAL: bool>(&self, f: &Frame, src: &[f32], out: &mut [f32], y: usize) {
         let (w, h) = (f.width, f.height);
         let lim = if VERTICAL { h - 1 } else { w - 1 } as i32;
-        let nt = self.offsets_mm.len();
-        s.inv.resize(w, 0.0);
-        s.frac.resize_with(nt, Vec::new);
-        s.j0.resize_with(nt, Vec::new);
-        s.j1.resize_with(nt, Vec::new);
-        for (i, &m) in s.inv.iter_mut().zip(&f.mm_per_pixel[y * w..(y + 1) * w]) {
-            *i = 1.0 / m;
-        }
-        for t in 0..nt {
-            let o_mm = self.offsets_mm[t];
-            let (fr, j0, j1) = (&mut s.frac[t], &mut s.j0[t], &mut s.j1[t]);
-            fr.resize(w, 0.0);
-            j0.resize(w, 0);
-            j1.resize(w, 0);
-            for x in 0..w {
-                let p = if VERTICAL { y } else { x } as f32 - o_mm * s.inv[x];
-                let p0 = p.floor();
-                fr[x] = p - p0;
-                let (k0, k1) = ((p0 as i32).clamp(0, lim), (p0 as i32 + 1).clamp(0, lim));
-                (j0[x], j1[x]) = if VERTICAL {
-                    ((k0 as usize * w + x) as u32, (k1 as usize * w + x) as u32)
-                } else {
-                    ((y * w + k0 as usize) as u32, (y * w + k1 as usize) as u32)
-                };
+        let mm = &f.mm_per_pixel[y * w..(y + 1) * w];
+        let mut x0 = 0;
+        while x0 < w {
+            let n = BLOCK.min(w - x0);
+            let mut inv = [0.0f32; BLOCK];
+            for l in 0..n {
+                inv[l] = 1.0 / mm[x0 + l];
             }
-        }
-        for (x, o) in out.chunks_exact_mut(3).enumerate() {
-            let mut acc = [0.0f32; 4];
-            for t in 0..nt {
-                let (a, b) = (texel4(src, s.j0[t][x]), texel4(src, s.j1[t][x]));
-                let (fr, wt) = (s.frac[t][x], &self.weights[t]);
-                for c in 0..4 {
-                    acc[c] += wt[c] * (a[c] + fr * (b[c] - a[c]));
+            let mut acc = [0.0f32; 3 * BLOCK];
+            for ((&o_mm, wt), wl) in self.offsets_mm.iter().zip(&self.weights).zip(&self.lanes) {
+                // Per pixel: the first texel's coordinate along the pass and the fraction.
+                let (mut k0, mut fr) = ([0.0f32; BLOCK], [0.0f32; BLOCK]);
+                for l in 0..BLOCK {
+                    let p = if VERTICAL { y } else { x0 + l } as f32 - o_mm * inv[l];
+                    // ⌊p⌋ in float arithmetic that vectorises (exact for |p| < 2²²): round
+                    // to nearest by adding and subtracting 1.5·2²³, less one where that
+                    // rounded up.
+                    const ROUND: f32 = 12_582_912.0;
+                    let r = (p + ROUND) - ROUND;
+                    let p0 = r - if r > p { 1.0 } else { 0.0 };
+                    fr[l] = p - p0;
+                    k0[l] = p0 - if VERTICAL { 0.0 } else { l as f32 };
+                }
+                // One integer offset for the block: an OR fold of the bits (vectorises).
+                let differ = k0[..n]
+                    .iter()
+                    .fold(0u32, |a, k| a | (k.to_bits() ^ k0[0].to_bits()));
+                let c = k0[0] as i32;
+                let uniform = differ == 0;
+                let last = c + if VERTICAL { 0 } else { n as i32 - 1 } + 1;
+                if n == BLOCK && uniform && c >= 0 && last <= lim {
+                    let first = if VERTICAL {
+                        c as usize * w + x0
+                    } else {
+                        y * w + c as usize
+                    };
+                    let next = first + if VERTICAL { w } else { 1 };
+                    let (s0, s1) = (
+                        &src[3 * first..3 * first + 3 * BLOCK],
+                        &src[3 * next..3 * next + 3 * BLOCK],
+                    );
+                    // The fractions repeated over the channels, 8 pixels at a time as one
+                    // fixed shuffle.
+                    let mut fr3 = [0.0f32; 3 * BLOCK];
+                    for (d, q) in fr3.chunks_exact_mut(24).zip(fr.chunks_exact(8)) {
+                        let q: [f32; 8] = q.try_into().expect("8 values");
+                        d.copy_from_slice(&[
+                            q[0], q[0], q[0], q[1], q[1], q[1], q[2], q[2], q[2], q[3], q[3], q[3],
+                            q[4], q[4], q[4], q[5], q[5], q[5], q[6], q[6], q[6], q[7], q[7], q[7],
+                        ]);
+                    }
+                    for i in 0..3 * BLOCK {
+                        acc[i] += wl[i] * (s0[i] + fr3[i] * (s1[i] - s0[i]));
+                    }
+                } else {
+                    for l in 0..n {
+                        let p0 = k0[l] as i32 + if VERTICAL { 0 } else { l as i32 };
+                        let (q0, q1) = (p0.clamp(0, lim) as usize, (p0 + 1).clamp(0, lim) as usize);
+                        let (j0, j1) = if VERTICAL {
+                            (q0 * w + x0 + l, q1 * w + x0 + l)
+                        } else {
+                            (y * w + q0, y * w + q1)
+                        };
+                        for ch in 0..3 {
+                            let (a, b) = (src[3 * j0 + ch], src[3 * j1 + ch]);
+                            acc[3 * l + ch] += wt[ch] * (a + fr[l] * (b - a));
+                        }
+                    }
                 }
             }
-            o.copy_from_slice(&acc[..3]);
+            out[3 * x0..3 * (x0 + n)].copy_from_slice(&acc[..3 * n]);
+            x0 += n;
         }
     }
 
@@ -347,16 +388,22 @@ impl VarBlur {
         tmp.as_flattened_mut()
             .par_chunks_mut(3 * w)
             .enumerate()
-            .for_each_init(VarLanes::default, |s, (y, row)| {
-                dispatch(|| self.row::<false>(f, src, row, y, s))
-            });
+            .for_each(|(y, row)| self.dispatch::<false>(f, src, row, y));
         let tmp = tmp.as_flattened();
         out.as_flattened_mut()
             .par_chunks_mut(3 * w)
             .enumerate()
-            .for_each_init(VarLanes::default, |s, (y, row)| {
-                dispatch(|| self.row::<true>(f, tmp, row, y, s))
-            });
+            .for_each(|(y, row)| self.dispatch::<true>(f, tmp, row, y));
+    }
+
+    /// [`VarBlur::row`] in the AVX2 + FMA build where the CPU has it.
+    fn dispatch<const VERTICAL: bool>(&self, f: &Frame, src: &[f32], out: &mut [f32], y: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if fast_build() {
+            // SAFETY: the CPU has AVX2 and FMA (`fast_build`).
+            return unsafe { fast::var_row::<VERTICAL>(self, f, src, out, y) };
+        }
+        self.row::<VERTICAL>(f, src, out, y)
     }
 
     /// One pass at pixel (x, y) in f64, straight from the definition (for the self-check).
@@ -390,17 +437,6 @@ impl VarBlur {
         }
         v
     }
-}
-
-/// Runs `f` in the AVX2 build where the CPU has it.
-#[inline(always)]
-fn dispatch(f: impl FnOnce()) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2, checked just above.
-        return unsafe { avx2(f) };
-    }
-    f()
 }
 
 fn pool(threads: usize) -> rayon::ThreadPool {

@@ -83,7 +83,8 @@ fn built_in_scenes_filter_alike_on_both_paths() {
                             let (x, r) = (a[c] as f64, b[c] as f64);
                             let bound = 1e-5 * r.abs() + 1e-6 * magnitude[c];
                             worst = worst.max((x - r).abs() / bound.max(f64::MIN_POSITIVE));
-                            !((x - r).abs() <= bound)
+                            let within = (x - r).abs() <= bound;
+                            !within
                         })
                     })
                     .count();

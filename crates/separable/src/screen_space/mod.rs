@@ -37,9 +37,11 @@
 //! largest value for pixels near zero (signed kernels cancel); tested on synthetic frames and
 //! on every built-in scene. Which pixels take which form depends only on the inputs, so the
 //! result is identical for any thread count. On x86-64 the chunk loops are also compiled for
-//! AVX2 and FMA and picked at run time (the only `unsafe` in the crate, the call into that
-//! build after the CPU check); the baseline build multiplies and adds separately, so the two
-//! builds differ by rounding. Cost and its breakdown: `crates/bench/benches/separable.rs` and
+//! AVX2 and FMA and picked at run time (the call into that build after the CPU check is
+//! `unsafe`, and so are the raw 8-float loads of the rotated taps in that build, after one
+//! bounds check per chunk: the portable form of that loop compiles to about twice the
+//! instructions); the baseline build multiplies and adds separately, so the two builds differ
+//! by rounding. Cost and its breakdown: `crates/bench/benches/separable.rs` and
 //! the README.
 //!
 //! Output: per pixel, the diffuse exitance E ∗ R_d (with [`crate::Energy::TotalReflectance`]

@@ -1,6 +1,9 @@
-//! The row-chunked form of one separable pass: the same arithmetic as [`Pass::pixel`], in the
-//! same order, so the result is identical bit for bit, organised so the common case runs near
-//! memory speed.
+//! The row-chunked form of one separable pass: the same taps at the same positions as
+//! [`Pass::pixel`] (each pixel's tap positions are its f32 values), organised so the common
+//! case runs near memory speed, and rounded differently (fused multiply-adds in the AVX2
+//! build, rotated taps blended along y first and summed last): it matches the per-pixel form
+//! within 10⁻⁵ relative per pixel and channel (see the module documentation of
+//! [`super`]).
 //!
 //! A row is cut into chunks of [`CHUNK`] pixels. A chunk takes the fast path when every pixel
 //! in it is blurred (not background, not under the sub-pixel skip) and every texel its taps
@@ -12,15 +15,19 @@
 //!
 //! On the fast path the chunk is a flat run of 3 × [`CHUNK`] floats (the RGB layout of the
 //! images) and each tap is one loop over it:
-//! - an axis-aligned tap computes each pixel's fractional position (repeated over its three
-//!   channels) and, when the integer offset is the same across the chunk and inside the image,
-//!   blends two contiguous runs of the source row (horizontal pass) or of the source rows
-//!   `y + k` and `y + k + 1` (vertical pass) — no clamps, no silhouette tests, no gathers;
-//!   where the offset varies (the footprint changes across the chunk) or reaches past the
-//!   border, it reads per pixel with the border clamp;
+//! - an axis-aligned tap computes each pixel's position (then its fraction, repeated over its
+//!   three channels). When the integer offset is the same across the chunk and inside the
+//!   image, it blends two contiguous runs of the source row (horizontal pass) or of the source
+//!   rows `y + k` and `y + k + 1` (vertical pass) — no clamps, no silhouette tests, no
+//!   gathers; when the footprint changes across the chunk so that the offset takes two
+//!   values, three contiguous runs, each pixel blending the first two or the last two; else
+//!   (more offsets, or reads past the border) it reads per pixel with the border clamp;
 //! - a rotated (jittered) tap is a bilinear read at a per-pixel angle: positions and cells
-//!   are computed for all pixels at once, then each pixel reads its four texels as 4-float
-//!   loads and blends them in one 4-wide vector.
+//!   are computed for all pixels at once; when every cell is inside the image, the tap is
+//!   kept and, after the axis taps, each pixel sums its kept rotated taps with two 8-float
+//!   loads per tap (the cell's two texels of a row are six contiguous floats; AVX2 intrinsics
+//!   in the AVX2 build, whose raw loads are the crate's second `unsafe`, after one bounds
+//!   check per chunk); near the border each pixel reads its four clamped texels.
 
 use super::pixel::{Pass, PassTaps};
 use super::{NO_OBJECT, ScreenInput, rotation_index};
@@ -34,6 +41,10 @@ const SUBCHUNK: usize = 16;
 const FLOATS: usize = 3 * CHUNK;
 /// Rotated taps whose positions a chunk holds at once (more are summed in batches).
 const ROTATED: usize = 4;
+/// Per held rotated tap, one value per pixel of a chunk.
+type Slots<T> = [[T; CHUNK]; ROTATED];
+/// A rotated tap's row weights at fx = 0 and their change per unit of fx (8 lanes each).
+type RowWeights = ([f32; 8], [f32; 8]);
 /// Pixels per summary cell.
 const CELL: usize = 16;
 
@@ -196,7 +207,9 @@ impl Summary {
 }
 
 /// The rotation step of every pixel ([`rotation_index`]), shared by every pass and term:
-/// computed once per frame when the filter jitters.
+/// computed once per frame when the filter jitters. (One byte per pixel: a table of its
+/// cosine and sine would save the per-chunk lookup but is 8 times the memory, and a fresh
+/// allocation per frame costs more in page faults than the lookup.)
 pub(super) struct PixelTable {
     /// Rotation step of each pixel (empty without jitter).
     rotation: Vec<u8>,
@@ -299,9 +312,9 @@ pub(super) struct Lanes {
     hi3: [f32; FLOATS],
     /// Per rotated tap inside the image: each pixel's first texel, bilinear fractions, and
     /// the tap's index (grown to the most such taps seen).
-    rj: [[u32; CHUNK]; ROTATED],
-    rfx: [[f32; CHUNK]; ROTATED],
-    rfy: [[f32; CHUNK]; ROTATED],
+    rj: Slots<u32>,
+    rfx: Slots<f32>,
+    rfy: Slots<f32>,
     rtap: [usize; ROTATED],
     /// The folded rotated sums, RGB per pixel (and one float written past the last pixel).
     rot3: [f32; FLOATS + 1],
@@ -620,10 +633,12 @@ fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     }
 
     if JITTER {
+        // The pass's rotated axis (c, s), or (−s, c) for the vertical pass (whose −s is
+        // applied as an added product: x − o·(−s) = x + o·s, the same bits).
         let rot = &ctx.table.rotation[i0..i0 + n];
         for l in 0..n {
             let (c, s) = pass.rotations[rot[l] as usize];
-            (lanes.rdx[l], lanes.rdy[l]) = if VERTICAL { (-s, c) } else { (c, s) };
+            (lanes.rdx[l], lanes.rdy[l]) = if VERTICAL { (s, c) } else { (c, s) };
         }
     }
     lanes.acc[..m].fill(0.0);
@@ -650,7 +665,7 @@ fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
                 inside = 0;
             }
             let (wf, hf) = (wmax as f32, hmax as f32);
-            let edge = rotated_cells::<A>(
+            let edge = rotated_cells::<VERTICAL, A>(
                 (o_mm, yf, w, wf, hf),
                 &lanes.inv[..n],
                 (&lanes.px[..n], &lanes.rdx[..n], &lanes.rdy[..n]),
@@ -799,7 +814,7 @@ fn rotated_sums<A: MulAdd>(
     let rot3 = &mut lanes.rot3;
     #[cfg(target_arch = "x86_64")]
     if A::AVX2 {
-        let mut w8 = [([0.0f32; 8], [0.0f32; 8]); ROTATED];
+        let mut w8: [RowWeights; ROTATED] = [([0.0; 8], [0.0; 8]); ROTATED];
         for (q, &k) in rtap.iter().enumerate() {
             w8[q] = (taps.rot_lo[k], taps.rot_d[k]);
         }
@@ -842,12 +857,13 @@ fn rotated_sums<A: MulAdd>(
     }
 }
 
-/// A rotated tap's cells for the chunk's pixels: `rj` the first texel (unclamped),
+/// A rotated tap's cells for the chunk's pixels (`rdx` holds −(the x direction) in the
+/// vertical pass): `rj` the first texel (unclamped),
 /// `f` the bilinear fractions, `c` the floored positions; returns whether a cell reaches past
 /// the border (then `rj` is not valid). Separate arguments, so the compiler knows the arrays
 /// do not overlap and vectorises the loop.
 #[inline(always)]
-fn rotated_cells<A: MulAdd>(
+fn rotated_cells<const VERTICAL: bool, A: MulAdd>(
     (o_mm, yf, w, wf, hf): (f32, f32, usize, f32, f32),
     inv: &[f32],
     (px, rdx, rdy): (&[f32], &[f32], &[f32]),
@@ -867,7 +883,12 @@ fn rotated_cells<A: MulAdd>(
     let mut edge = 0u32;
     for l in 0..n {
         let o = o_mm * inv[l];
-        let (sx, sy) = (px[l] - o * rdx[l], yf - o * rdy[l]);
+        let sx = if VERTICAL {
+            px[l] + o * rdx[l]
+        } else {
+            px[l] - o * rdx[l]
+        };
+        let sy = yf - o * rdy[l];
         let (cx, cy) = (A::floor(sx), A::floor(sy));
         rfx[l] = sx - cx;
         rfy[l] = sy - cy;
@@ -890,12 +911,8 @@ fn rotated_cells<A: MulAdd>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn rotated_pixels_avx2(
-    (rj, rfx, rfy): (
-        &[[u32; CHUNK]; ROTATED],
-        &[[f32; CHUNK]; ROTATED],
-        &[[f32; CHUNK]; ROTATED],
-    ),
-    (w8, inside): (&[([f32; 8], [f32; 8]); ROTATED], usize),
+    (rj, rfx, rfy): (&Slots<u32>, &Slots<f32>, &Slots<f32>),
+    (w8, inside): (&[RowWeights; ROTATED], usize),
     src: &[f32],
     down: usize,
     rot3: &mut [f32; FLOATS + 1],
