@@ -406,6 +406,7 @@ fn row_avx2<const VERTICAL: bool, const JITTER: bool>(
 pub(super) trait MulAdd {
     /// Whether this is the AVX2 + FMA build ([`Fused`], only used by `row_avx2`, after the
     /// CPU check).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     const AVX2: bool;
     /// a · b + c.
     fn fma(a: f32, b: f32, c: f32) -> f32;
@@ -415,6 +416,7 @@ pub(super) trait MulAdd {
 }
 
 /// [`MulAdd`] as one fused operation ([`f32::mul_add`]).
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 pub(super) struct Fused;
 
 /// [`MulAdd`] as a multiply and an add.
