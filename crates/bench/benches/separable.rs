@@ -2,9 +2,14 @@
 //! 1920 × 1080 RGB f32 frame, against the memory-bound limit (copying the same buffers), the
 //! 6-Gaussian baseline (d'Eon et al. 2007, 12 passes) and the exact 2D convolution.
 //!
-//! Frame: one skin1 object (better dipole) filling the screen, 0.5 mm per pixel (a head and
-//! shoulders shot: the 99 % kernel radius, 14 mm, spans 28 pixels), a pore-like irradiance
-//! texture, a gentle depth ramp, default filter options (jitter within 10 % of the kernel).
+//! Frames: one skin1 object (better dipole) filling the screen, a pore-like irradiance texture,
+//! default filter options (jitter within 10 % of the kernel). The first frame (`1080p`) is at a
+//! constant 0.5 mm per pixel (a head and shoulders shot: the 99 % kernel radius, 14 mm, spans
+//! 28 pixels) with a gentle depth ramp; the second (`1080p-tilted`) is a surface whose
+//! footprint grows linearly from 0.3 mm per pixel at the left edge to 0.7 at the right (and by
+//! 0.05 down the frame), with depth growing along both axes, so every pixel's tap positions
+//! differ from its neighbours' (the depth ramp stays under the rejection threshold: the frame
+//! measures varying footprints, not silhouettes).
 //! Kernels: the pre-integrated kernel with 7 importance-sampled taps per pass; six Gaussians
 //! with 7 importance-sampled taps per pass each. The exact 2D convolution is far too slow at
 //! 1080p (N² taps per pixel), so it runs on a 256 × 256 crop with a 31 × 31 kernel grid, next
@@ -58,6 +63,20 @@ impl Frame {
             mask: &self.mask,
             mm_per_pixel: &self.mm_per_pixel,
         }
+    }
+}
+
+impl Frame {
+    /// The second frame: the same texture on a surface whose footprint grows across the frame.
+    fn tilted(width: usize, height: usize) -> Frame {
+        let mut f = Frame::new(width, height);
+        let (wf, hf) = (width.max(2) as f32 - 1.0, height.max(2) as f32 - 1.0);
+        for (i, (d, m)) in f.depth.iter_mut().zip(&mut f.mm_per_pixel).enumerate() {
+            let (x, y) = ((i % width) as f32, (i / width) as f32);
+            *m = 0.3 + 0.4 * x / wf + 0.05 * y / hf;
+            *d = 600.0 + 0.1 * x + 0.05 * y;
+        }
+        f
     }
 }
 
@@ -194,31 +213,230 @@ impl PlainBlur {
         tmp.as_flattened_mut()
             .par_chunks_mut(3 * w)
             .enumerate()
-            .for_each(|(y, row)| self.dispatch(|| self.row_h(src, row, y, w)));
+            .for_each(|(y, row)| {
+                #[cfg(target_arch = "x86_64")]
+                if fast_build() {
+                    // SAFETY: the CPU has AVX2 and FMA (`fast_build`).
+                    return unsafe { fast::plain_h(self, src, row, y, w) };
+                }
+                self.row_h(src, row, y, w)
+            });
         let tmp = tmp.as_flattened();
         out.as_flattened_mut()
             .par_chunks_mut(3 * w)
             .enumerate()
-            .for_each(|(y, row)| self.dispatch(|| self.row_v(tmp, row, y, w, h)));
-    }
-
-    #[inline(always)]
-    fn dispatch(&self, f: impl FnOnce()) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2, checked just above.
-            return unsafe { avx2(f) };
-        }
-        f()
+            .for_each(|(y, row)| {
+                #[cfg(target_arch = "x86_64")]
+                if fast_build() {
+                    // SAFETY: the CPU has AVX2 and FMA (`fast_build`).
+                    return unsafe { fast::plain_v(self, tmp, row, y, (w, h)) };
+                }
+                self.row_v(tmp, row, y, w, h)
+            });
     }
 }
 
-/// Runs `f` (inlined) compiled for AVX2.
+/// Whether the CPU has AVX2 and FMA: the floors then run the rows compiled for them, as the
+/// pass under test does.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-fn avx2(f: impl FnOnce()) {
-    f()
+fn fast_build() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
+
+/// The floors' rows compiled for AVX2 and FMA (the row functions are inlined into these; a
+/// closure passed to a `target_feature` function is not reliably inlined, and then runs in
+/// the baseline build).
+#[cfg(target_arch = "x86_64")]
+mod fast {
+    use super::{Frame, PlainBlur, VarBlur};
+
+    #[target_feature(enable = "avx2,fma")]
+    pub fn plain_h(b: &PlainBlur, src: &[f32], out: &mut [f32], y: usize, w: usize) {
+        b.row_h(src, out, y, w)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    pub fn plain_v(b: &PlainBlur, src: &[f32], out: &mut [f32], y: usize, (w, h): (usize, usize)) {
+        b.row_v(src, out, y, w, h)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    pub fn var_row<const VERTICAL: bool>(
+        b: &VarBlur,
+        f: &Frame,
+        src: &[f32],
+        out: &mut [f32],
+        y: usize,
+    ) {
+        b.row::<VERTICAL>(f, src, out, y)
+    }
+}
+
+/// The floor for what the pass must do per pixel: the plain blur with each pixel's own tap
+/// positions (offsets in mm divided by its `mm_per_pixel`, in f32 as the separable pass places
+/// them), two texels linearly interpolated per tap, borders clamped, but no silhouette tests,
+/// no jitter and no skip. Written like [`PlainBlur`]: blocks of [`BLOCK`] pixels as flat f32
+/// runs with the sums in registers; per tap, the block's positions are computed per pixel and,
+/// where every pixel of the block has the same integer offset (the footprint changes slowly)
+/// and the reads stay inside the image, the tap is two contiguous runs blended per float;
+/// otherwise each pixel reads its two texels with the border clamp.
+struct VarBlur {
+    offsets_mm: Vec<f32>,
+    weights: Vec<[f32; 3]>,
+    /// Per tap, its RGB weights repeated over a block of [`BLOCK`] pixels.
+    lanes: Vec<[f32; 3 * BLOCK]>,
+}
+
+impl VarBlur {
+    fn new(kernel: &SeparableKernel) -> VarBlur {
+        let taps = &kernel.terms[0].horizontal.taps;
+        VarBlur {
+            offsets_mm: taps.iter().map(|t| t.offset_mm as f32).collect(),
+            weights: taps.iter().map(|t| t.weight.map(|w| w as f32)).collect(),
+            lanes: taps
+                .iter()
+                .map(|t| std::array::from_fn(|i| t.weight[i % 3] as f32))
+                .collect(),
+        }
+    }
+
+    /// Row `y` of one pass (VERTICAL: along columns) of `src` into `out`.
+    #[inline(always)]
+    fn row<const VERTICAL: bool>(&self, f: &Frame, src: &[f32], out: &mut [f32], y: usize) {
+        let (w, h) = (f.width, f.height);
+        let lim = if VERTICAL { h - 1 } else { w - 1 } as i32;
+        let mm = &f.mm_per_pixel[y * w..(y + 1) * w];
+        let mut x0 = 0;
+        while x0 < w {
+            let n = BLOCK.min(w - x0);
+            let mut inv = [0.0f32; BLOCK];
+            for l in 0..n {
+                inv[l] = 1.0 / mm[x0 + l];
+            }
+            let mut acc = [0.0f32; 3 * BLOCK];
+            for ((&o_mm, wt), wl) in self.offsets_mm.iter().zip(&self.weights).zip(&self.lanes) {
+                // Per pixel: the first texel's coordinate along the pass and the fraction.
+                let (mut k0, mut fr) = ([0.0f32; BLOCK], [0.0f32; BLOCK]);
+                for l in 0..BLOCK {
+                    let p = if VERTICAL { y } else { x0 + l } as f32 - o_mm * inv[l];
+                    // ⌊p⌋ in float arithmetic that vectorises (exact for |p| < 2²²): round
+                    // to nearest by adding and subtracting 1.5·2²³, less one where that
+                    // rounded up.
+                    const ROUND: f32 = 12_582_912.0;
+                    let r = (p + ROUND) - ROUND;
+                    let p0 = r - if r > p { 1.0 } else { 0.0 };
+                    fr[l] = p - p0;
+                    k0[l] = p0 - if VERTICAL { 0.0 } else { l as f32 };
+                }
+                // One integer offset for the block: an OR fold of the bits (vectorises).
+                let differ = k0[..n]
+                    .iter()
+                    .fold(0u32, |a, k| a | (k.to_bits() ^ k0[0].to_bits()));
+                let c = k0[0] as i32;
+                let uniform = differ == 0;
+                let last = c + if VERTICAL { 0 } else { n as i32 - 1 } + 1;
+                if n == BLOCK && uniform && c >= 0 && last <= lim {
+                    let first = if VERTICAL {
+                        c as usize * w + x0
+                    } else {
+                        y * w + c as usize
+                    };
+                    let next = first + if VERTICAL { w } else { 1 };
+                    let (s0, s1) = (
+                        &src[3 * first..3 * first + 3 * BLOCK],
+                        &src[3 * next..3 * next + 3 * BLOCK],
+                    );
+                    // The fractions repeated over the channels, 8 pixels at a time as one
+                    // fixed shuffle.
+                    let mut fr3 = [0.0f32; 3 * BLOCK];
+                    for (d, q) in fr3.chunks_exact_mut(24).zip(fr.chunks_exact(8)) {
+                        let q: [f32; 8] = q.try_into().expect("8 values");
+                        d.copy_from_slice(&[
+                            q[0], q[0], q[0], q[1], q[1], q[1], q[2], q[2], q[2], q[3], q[3], q[3],
+                            q[4], q[4], q[4], q[5], q[5], q[5], q[6], q[6], q[6], q[7], q[7], q[7],
+                        ]);
+                    }
+                    for i in 0..3 * BLOCK {
+                        acc[i] += wl[i] * (s0[i] + fr3[i] * (s1[i] - s0[i]));
+                    }
+                } else {
+                    for l in 0..n {
+                        let p0 = k0[l] as i32 + if VERTICAL { 0 } else { l as i32 };
+                        let (q0, q1) = (p0.clamp(0, lim) as usize, (p0 + 1).clamp(0, lim) as usize);
+                        let (j0, j1) = if VERTICAL {
+                            (q0 * w + x0 + l, q1 * w + x0 + l)
+                        } else {
+                            (y * w + q0, y * w + q1)
+                        };
+                        for ch in 0..3 {
+                            let (a, b) = (src[3 * j0 + ch], src[3 * j1 + ch]);
+                            acc[3 * l + ch] += wt[ch] * (a + fr[l] * (b - a));
+                        }
+                    }
+                }
+            }
+            out[3 * x0..3 * (x0 + n)].copy_from_slice(&acc[..3 * n]);
+            x0 += n;
+        }
+    }
+
+    /// Horizontal pass into `tmp`, vertical pass into `out`, in the AVX2 build where the CPU
+    /// has it.
+    fn run(&self, f: &Frame, tmp: &mut [[f32; 3]], out: &mut [[f32; 3]]) {
+        let w = f.width;
+        let src = f.irradiance.as_flattened();
+        tmp.as_flattened_mut()
+            .par_chunks_mut(3 * w)
+            .enumerate()
+            .for_each(|(y, row)| self.dispatch::<false>(f, src, row, y));
+        let tmp = tmp.as_flattened();
+        out.as_flattened_mut()
+            .par_chunks_mut(3 * w)
+            .enumerate()
+            .for_each(|(y, row)| self.dispatch::<true>(f, tmp, row, y));
+    }
+
+    /// [`VarBlur::row`] in the AVX2 + FMA build where the CPU has it.
+    fn dispatch<const VERTICAL: bool>(&self, f: &Frame, src: &[f32], out: &mut [f32], y: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if fast_build() {
+            // SAFETY: the CPU has AVX2 and FMA (`fast_build`).
+            return unsafe { fast::var_row::<VERTICAL>(self, f, src, out, y) };
+        }
+        self.row::<VERTICAL>(f, src, out, y)
+    }
+
+    /// One pass at pixel (x, y) in f64, straight from the definition (for the self-check).
+    fn pass_f64(
+        &self,
+        f: &Frame,
+        img: &dyn Fn(usize, usize) -> [f64; 3],
+        x: usize,
+        y: usize,
+        vertical: bool,
+    ) -> [f64; 3] {
+        let (w, h) = (f.width, f.height);
+        let inv = 1.0 / f.mm_per_pixel[y * w + x] as f64;
+        let mut v = [0.0f64; 3];
+        for (&o, wt) in self.offsets_mm.iter().zip(&self.weights) {
+            let p = if vertical { y } else { x } as f64 - o as f64 * inv;
+            let (p0, fr) = (p.floor(), p - p.floor());
+            let lim = if vertical { h - 1 } else { w - 1 } as f64;
+            let (k0, k1) = (
+                p0.clamp(0.0, lim) as usize,
+                (p0 + 1.0).clamp(0.0, lim) as usize,
+            );
+            let (a, b) = if vertical {
+                (img(x, k0), img(x, k1))
+            } else {
+                (img(k0, y), img(k1, y))
+            };
+            for c in 0..3 {
+                v[c] += wt[c] as f64 * (a[c] + fr * (b[c] - a[c]));
+            }
+        }
+        v
+    }
 }
 
 fn pool(threads: usize) -> rayon::ThreadPool {
@@ -276,12 +494,57 @@ fn separable(c: &mut Criterion) {
             );
         }
     }
+    let tilted = Frame::tilted(1920, 1080);
+    // The variable-footprint floor computes what it claims: a few pixels of both frames
+    // against the two passes written out in f64.
+    let var = VarBlur::new(&pre7);
+    for f in [&frame, &tilted] {
+        var.run(f, &mut tmp, &mut out);
+        let w = f.width;
+        let src = |x: usize, y: usize| f.irradiance[y * w + x].map(f64::from);
+        let hpass = |x: usize, y: usize| var.pass_f64(f, &src, x, y, false);
+        for (x, y) in [(0, 0), (5, 700), (960, 540), (1919, 1079), (1000, 3)] {
+            let want = var.pass_f64(f, &hpass, x, y, true);
+            for c in 0..3 {
+                let got = out[y * w + x][c] as f64;
+                assert!(
+                    (got - want[c]).abs() <= 1e-4 * want[c].abs().max(1e-3),
+                    "variable-footprint floor ({x},{y}): {got} vs {}",
+                    want[c]
+                );
+            }
+        }
+    }
+    // How much of the tilted frame takes the row-chunked fast path (printed for the README).
+    let fast = screen_space::filter_into_with(
+        &tilted.input(),
+        &pre7,
+        &opts,
+        &mut scratch,
+        &mut out,
+        screen_space::Evaluation::Rows,
+    )
+    .expect("filter");
+    eprintln!(
+        "tilted frame: {:.1} % of pixel passes on the fast path",
+        100.0 * fast
+    );
     for (name, threads) in [
         ("plain-blur-7taps/1-thread", &one),
         ("plain-blur-7taps/2-threads", &two),
     ] {
         g.bench_function(name, |b| {
             b.iter(|| threads.install(|| plain.run(black_box(&frame), &mut tmp, &mut out)))
+        });
+    }
+    for (name, f, threads) in [
+        ("variable-footprint-floor/1-thread", &frame, &one),
+        ("variable-footprint-floor/2-threads", &frame, &two),
+        ("tilted/variable-footprint-floor/1-thread", &tilted, &one),
+        ("tilted/variable-footprint-floor/2-threads", &tilted, &two),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| threads.install(|| var.run(black_box(f), &mut tmp, &mut out)))
         });
     }
     g.bench_function("pre-integrated-7taps-per-pixel/2-threads", |b| {
@@ -299,17 +562,39 @@ fn separable(c: &mut Criterion) {
             })
         })
     });
-    for (name, kernel, threads) in [
-        ("pre-integrated-7taps/1-thread", &pre7, &one),
-        ("pre-integrated-7taps/2-threads", &pre7, &two),
-        ("6-gaussians-7taps/1-thread", &gauss6, &one),
-        ("6-gaussians-7taps/2-threads", &gauss6, &two),
+    g.bench_function("tilted/pre-integrated-7taps-per-pixel/2-threads", |b| {
+        b.iter(|| {
+            two.install(|| {
+                screen_space::filter_into_with(
+                    black_box(&tilted.input()),
+                    &pre7,
+                    &opts,
+                    &mut scratch,
+                    &mut out,
+                    screen_space::Evaluation::PerPixel,
+                )
+                .expect("filter")
+            })
+        })
+    });
+    for (name, f, kernel, threads) in [
+        ("pre-integrated-7taps/1-thread", &frame, &pre7, &one),
+        ("pre-integrated-7taps/2-threads", &frame, &pre7, &two),
+        ("tilted/pre-integrated-7taps/1-thread", &tilted, &pre7, &one),
+        (
+            "tilted/pre-integrated-7taps/2-threads",
+            &tilted,
+            &pre7,
+            &two,
+        ),
+        ("6-gaussians-7taps/1-thread", &frame, &gauss6, &one),
+        ("6-gaussians-7taps/2-threads", &frame, &gauss6, &two),
     ] {
         g.bench_function(name, |b| {
             b.iter(|| {
                 threads.install(|| {
                     screen_space::filter_into(
-                        black_box(&frame.input()),
+                        black_box(&f.input()),
                         kernel,
                         &opts,
                         &mut scratch,

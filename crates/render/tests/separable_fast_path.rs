@@ -1,7 +1,9 @@
 //! The screen-space pass's row-chunked fast path against its per-pixel form on the inputs of
 //! every built-in scene (real silhouettes, depth layers, footprints that change across the
-//! image, several objects and materials): identical bits, at the scenes' resolution and at
-//! 4× it (where kernels span many pixels and most chunks take the fast path).
+//! image, several objects and materials): within 10⁻⁵ relative per pixel and channel (with an
+//! absolute floor of 10⁻⁶ of the channel's largest value, for pixels near zero; the reasons
+//! are in `crates/separable/tests/screen_space_rows.rs`), at the scenes' resolution and at 4×
+//! it (where kernels span many pixels and most chunks take the fast path).
 
 use sss_render::frame::Frame;
 use sss_render::integrators::separable::screen_buffers;
@@ -11,7 +13,7 @@ use sss_separable::NO_OBJECT;
 use sss_separable::screen_space::{Evaluation, filter_into_with};
 
 #[test]
-fn built_in_scenes_filter_identically_on_both_paths() {
+fn built_in_scenes_filter_alike_on_both_paths() {
     let mut fast_seen = 0.0f64;
     for &(name, _) in BUILTIN_SCENES {
         let Ok(mut scene) = builtin(name, &LoadOptions::from_env()) else {
@@ -66,10 +68,25 @@ fn built_in_scenes_filter_identically_on_both_paths() {
                 };
                 let (rows, fast) = run(Evaluation::Rows);
                 let (reference, _) = run(Evaluation::PerPixel);
+                let magnitude: [f64; 3] = std::array::from_fn(|c| {
+                    reference
+                        .iter()
+                        .map(|p| p[c].abs() as f64)
+                        .fold(0.0, f64::max)
+                });
+                let mut worst = 0.0f64;
                 let different = rows
                     .iter()
                     .zip(&reference)
-                    .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+                    .filter(|(a, b)| {
+                        (0..3).any(|c| {
+                            let (x, r) = (a[c] as f64, b[c] as f64);
+                            let bound = 1e-5 * r.abs() + 1e-6 * magnitude[c];
+                            worst = worst.max((x - r).abs() / bound.max(f64::MIN_POSITIVE));
+                            let within = (x - r).abs() <= bound;
+                            !within
+                        })
+                    })
                     .count();
                 let shown = mask.iter().filter(|&&o| o != NO_OBJECT).count();
                 let blurred = mm
@@ -80,7 +97,7 @@ fn built_in_scenes_filter_identically_on_both_paths() {
                 eprintln!(
                     "{name} ×{scale} material {m}: {w}×{h}, {shown} pixels shown, {blurred} \
                      blurred, support {:.2} mm, median mm/px {:.3}, fast path {:.1} % of \
-                     their pixel passes",
+                     their pixel passes, largest error {worst:.3} of the tolerance",
                     kernel.support_mm,
                     {
                         let mut v: Vec<f32> = mm
@@ -92,11 +109,11 @@ fn built_in_scenes_filter_identically_on_both_paths() {
                         v.sort_by(f32::total_cmp);
                         v.get(v.len() / 2).copied().unwrap_or(0.0)
                     },
-                    100.0 * fast * (w * h) as f64 / shown.max(1) as f64
+                    100.0 * fast * (w * h) as f64 / shown.max(1) as f64,
                 );
                 // Background pixels are never on the fast path: the share of the shown ones.
                 let share = fast * (w * h) as f64 / shown.max(1) as f64;
-                assert_eq!(different, 0, "{name} ×{scale} material {m}: pixels differ");
+                assert_eq!(different, 0, "{name} ×{scale} material {m}: pixels off");
                 fast_seen = fast_seen.max(share);
             }
             scene.camera.width /= scale;

@@ -29,12 +29,20 @@
 //! per-texel tests; that test is hoisted into a per-frame summary of object ids and depth
 //! ranges per 16-pixel cell (and per 8-row band), so a chunk checks a few cells. The others
 //! (near silhouettes, mixed or skipped pixels) retry as 16-pixel pieces, then go pixel by
-//! pixel (`pixel.rs`: the straightforward form, each texel tested). Both forms do the same
-//! IEEE operations in the same order, so the result is identical bit for bit (tested on
-//! synthetic frames and on every built-in scene) and for any thread count. On x86-64 the
-//! chunk loops are also compiled for AVX2 and picked at run time (the only `unsafe` in the
-//! crate, the call into that build after the CPU check). Cost and its breakdown:
-//! `crates/bench/benches/separable.rs` and the README.
+//! pixel (`pixel.rs`: the straightforward form, each texel tested, the reference). The chunked
+//! form computes the same taps at the same positions (each pixel's tap positions are the
+//! per-pixel form's f32 values), but rounds differently: fused multiply-adds, rotated taps
+//! blended along y first and summed after the axis taps. It matches the per-pixel form within
+//! 10⁻⁵ relative per pixel and channel, with an absolute floor of 10⁻⁶ of the channel's
+//! largest value for pixels near zero (signed kernels cancel); tested on synthetic frames and
+//! on every built-in scene. Which pixels take which form depends only on the inputs, so the
+//! result is identical for any thread count. On x86-64 the chunk loops are also compiled for
+//! AVX2 and FMA and picked at run time (the call into that build after the CPU check is
+//! `unsafe`, and so are the raw 8-float loads of the rotated taps in that build, after one
+//! bounds check per chunk: the portable form of that loop compiles to about twice the
+//! instructions); the baseline build multiplies and adds separately, so the two builds differ
+//! by rounding. Cost and its breakdown: `crates/bench/benches/separable.rs` and
+//! the README.
 //!
 //! Output: per pixel, the diffuse exitance E ∗ R_d (with [`crate::Energy::TotalReflectance`]
 //! kernels); the caller applies its Fresnel / π factors. Background pixels
@@ -264,14 +272,14 @@ pub fn filter_into(
     )
 }
 
-/// How the passes are evaluated; both give the same bits.
+/// How the passes are evaluated; they agree within rounding (see the module documentation).
 #[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Evaluation {
     /// Row chunks with the silhouette test hoisted ([`filter_into`]).
     Rows,
-    /// [`Evaluation::Rows`] in the x86-64 baseline instruction set even where AVX2 is
-    /// available (both must give the same bits).
+    /// [`Evaluation::Rows`] in the x86-64 baseline instruction set even where AVX2 and FMA
+    /// are available (multiplies and adds not fused: the two agree within rounding).
     RowsBaseline,
     /// Every tap of every pixel fetched and tested on its own: the plain form the chunked one
     /// is tested against (and measured against in `crates/bench/benches/separable.rs`).

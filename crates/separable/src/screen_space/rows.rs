@@ -1,6 +1,9 @@
-//! The row-chunked form of one separable pass: the same arithmetic as [`Pass::pixel`], in the
-//! same order, so the result is identical bit for bit, organised so the common case runs near
-//! memory speed.
+//! The row-chunked form of one separable pass: the same taps at the same positions as
+//! [`Pass::pixel`] (each pixel's tap positions are its f32 values), organised so the common
+//! case runs near memory speed, and rounded differently (fused multiply-adds in the AVX2
+//! build, rotated taps blended along y first and summed last): it matches the per-pixel form
+//! within 10⁻⁵ relative per pixel and channel (see the module documentation of
+//! [`super`]).
 //!
 //! A row is cut into chunks of [`CHUNK`] pixels. A chunk takes the fast path when every pixel
 //! in it is blurred (not background, not under the sub-pixel skip) and every texel its taps
@@ -12,15 +15,19 @@
 //!
 //! On the fast path the chunk is a flat run of 3 × [`CHUNK`] floats (the RGB layout of the
 //! images) and each tap is one loop over it:
-//! - an axis-aligned tap computes each pixel's fractional position (repeated over its three
-//!   channels) and, when the integer offset is the same across the chunk and inside the image,
-//!   blends two contiguous runs of the source row (horizontal pass) or of the source rows
-//!   `y + k` and `y + k + 1` (vertical pass) — no clamps, no silhouette tests, no gathers;
-//!   where the offset varies (the footprint changes across the chunk) or reaches past the
-//!   border, it reads per pixel with the border clamp;
+//! - an axis-aligned tap computes each pixel's position (then its fraction, repeated over its
+//!   three channels). When the integer offset is the same across the chunk and inside the
+//!   image, it blends two contiguous runs of the source row (horizontal pass) or of the source
+//!   rows `y + k` and `y + k + 1` (vertical pass) — no clamps, no silhouette tests, no
+//!   gathers; when the footprint changes across the chunk so that the offset takes two
+//!   values, three contiguous runs, each pixel blending the first two or the last two; else
+//!   (more offsets, or reads past the border) it reads per pixel with the border clamp;
 //! - a rotated (jittered) tap is a bilinear read at a per-pixel angle: positions and cells
-//!   are computed for all pixels at once, then each pixel reads its four texels as 4-float
-//!   loads and blends them in one 4-wide vector.
+//!   are computed for all pixels at once; when every cell is inside the image, the tap is
+//!   kept and, after the axis taps, each pixel sums its kept rotated taps with two 8-float
+//!   loads per tap (the cell's two texels of a row are six contiguous floats; AVX2 intrinsics
+//!   in the AVX2 build, whose raw loads are the crate's second `unsafe`, after one bounds
+//!   check per chunk); near the border each pixel reads its four clamped texels.
 
 use super::pixel::{Pass, PassTaps};
 use super::{NO_OBJECT, ScreenInput, rotation_index};
@@ -32,6 +39,12 @@ pub(super) const CHUNK: usize = 64;
 const SUBCHUNK: usize = 16;
 /// Floats per chunk (RGB).
 const FLOATS: usize = 3 * CHUNK;
+/// Rotated taps whose positions a chunk holds at once (more are summed in batches).
+const ROTATED: usize = 4;
+/// Per held rotated tap, one value per pixel of a chunk.
+type Slots<T> = [[T; CHUNK]; ROTATED];
+/// A rotated tap's row weights at fx = 0 and their change per unit of fx (8 lanes each).
+type RowWeights = ([f32; 8], [f32; 8]);
 /// Pixels per summary cell.
 const CELL: usize = 16;
 
@@ -79,6 +92,21 @@ impl Cell {
     }
 }
 
+/// A key of f32 bits that orders like the floats (negative ones reversed below the
+/// positive ones; −0 just below +0).
+#[inline(always)]
+fn order_key(bits: u32) -> u32 {
+    let neg = 0u32.wrapping_sub(bits >> 31);
+    bits ^ (neg | 0x8000_0000)
+}
+
+/// The f32 bits of an [`order_key`].
+#[inline(always)]
+fn order_bits(key: u32) -> u32 {
+    let pos = 0u32.wrapping_sub(key >> 31);
+    key ^ (!pos | 0x8000_0000)
+}
+
 impl Summary {
     /// Scans `input`'s mask and depth once.
     pub fn new(input: &ScreenInput) -> Summary {
@@ -99,18 +127,23 @@ impl Summary {
                     let a = y * w + c * CELL;
                     let b = (a + CELL).min(y * w + w);
                     let id = input.mask[a];
+                    // Integer folds (they vectorise; float min/max folds do not): a
+                    // non-finite depth sets `odd`, and the depth range is the range of
+                    // order-preserving keys of the finite depths.
                     let mut odd = 0u32;
-                    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+                    let (mut lo, mut hi) = (u32::MAX, 0u32);
                     for (&m, &d) in input.mask[a..b].iter().zip(&input.depth[a..b]) {
-                        odd |= (m ^ id) | u32::from(!d.is_finite());
-                        lo = lo.min(d);
-                        hi = hi.max(d);
+                        let bits = d.to_bits();
+                        odd |= (m ^ id) | u32::from(bits & 0x7F80_0000 == 0x7F80_0000);
+                        let key = order_key(bits);
+                        lo = lo.min(key);
+                        hi = hi.max(key);
                     }
                     *cell = Cell {
                         id,
                         uniform: id != NO_OBJECT && odd == 0,
-                        dmin: lo,
-                        dmax: hi,
+                        dmin: f32::from_bits(order_bits(lo)),
+                        dmax: f32::from_bits(order_bits(hi)),
                     };
                 }
             });
@@ -174,7 +207,9 @@ impl Summary {
 }
 
 /// The rotation step of every pixel ([`rotation_index`]), shared by every pass and term:
-/// computed once per frame when the filter jitters.
+/// computed once per frame when the filter jitters. (One byte per pixel: a table of its
+/// cosine and sine would save the per-chunk lookup but is 8 times the memory, and a fresh
+/// allocation per frame costs more in page faults than the lookup.)
 pub(super) struct PixelTable {
     /// Rotation step of each pixel (empty without jitter).
     rotation: Vec<u8>,
@@ -201,6 +236,12 @@ impl PixelTable {
 pub(super) struct ChunkTaps {
     /// Per tap, its RGB weights repeated over a chunk's floats.
     pattern: Vec<[f32; FLOATS]>,
+    /// Per tap, the weights of a rotated read's row pair (RGB of the left texel, RGB of the
+    /// right one, two unused lanes) at fx = 0, and their change per unit of fx: the weights
+    /// are `lo + fx · d` = [(1 − fx)·wt, fx·wt, 0, 0]. Runtime arrays, so the compiler keeps
+    /// the 8-lane arithmetic whole instead of folding the constant lanes.
+    rot_lo: Vec<[f32; 8]>,
+    rot_d: Vec<[f32; 8]>,
     /// Largest |offset| (mm) of the axis-aligned taps.
     axis_mm: f32,
     /// Largest |offset| (mm) of the rotated taps (0 without jitter).
@@ -224,6 +265,16 @@ impl ChunkTaps {
                 .weight
                 .iter()
                 .map(|w| std::array::from_fn(|i| w[i % 3]))
+                .collect(),
+            rot_lo: t
+                .weight
+                .iter()
+                .map(|w| [w[0], w[1], w[2], 0.0, 0.0, 0.0, 0.0, 0.0])
+                .collect(),
+            rot_d: t
+                .weight
+                .iter()
+                .map(|w| [-w[0], -w[1], -w[2], w[0], w[1], w[2], 0.0, 0.0])
                 .collect(),
             axis_mm,
             rotated_mm,
@@ -250,18 +301,30 @@ pub(super) struct Lanes {
     px: [f32; CHUNK],
     /// 1 / mm_per_pixel.
     inv: [f32; CHUNK],
-    /// An axis tap's first texel (minus the lane's own offset).
-    cell: [f32; CHUNK],
-    /// An axis tap's fractional position (in `fx`), repeated over the channels.
+    /// An axis tap's fractional position per pixel, and the same repeated over the channels.
+    frac: [f32; CHUNK],
     frac3: [f32; FLOATS],
-    /// A rotated tap's weighted value per pixel (RGB and a spare float).
-    term4: [[f32; 4]; CHUNK],
+    /// An axis tap's first texel minus the pixel's own offset, + 2²³, as bits.
+    key: [u32; CHUNK],
+    /// An axis tap's choice between two offsets (1: the larger) per pixel, and the same
+    /// repeated over the channels.
+    hi: [f32; CHUNK],
+    hi3: [f32; FLOATS],
+    /// Per rotated tap inside the image: each pixel's first texel, bilinear fractions, and
+    /// the tap's index (grown to the most such taps seen).
+    rj: Slots<u32>,
+    rfx: Slots<f32>,
+    rfy: Slots<f32>,
+    rtap: [usize; ROTATED],
+    /// The folded rotated sums, RGB per pixel (and one float written past the last pixel).
+    rot3: [f32; FLOATS + 1],
+    /// A rotated tap's cell (floored position) per pixel.
+    cx: [f32; CHUNK],
+    cy: [f32; CHUNK],
     /// Rotated axis direction.
     rdx: [f32; CHUNK],
     rdy: [f32; CHUNK],
-    /// Bilinear fractions and the four texel indices of a rotated tap.
-    fx: [f32; CHUNK],
-    fy: [f32; CHUNK],
+    /// The four texel indices of a rotated tap near the border.
     j: [[u32; CHUNK]; 4],
     /// The chunk's running sums, RGB per pixel.
     acc: [f32; FLOATS],
@@ -274,13 +337,21 @@ impl Lanes {
             lane: std::array::from_fn(|l| l as f32),
             px: [0.0; CHUNK],
             inv: [0.0; CHUNK],
-            cell: [0.0; CHUNK],
+            frac: [0.0; CHUNK],
             frac3: [0.0; FLOATS],
-            term4: [[0.0; 4]; CHUNK],
+            key: [0; CHUNK],
+            hi: [0.0; CHUNK],
+            hi3: [0.0; FLOATS],
+            rj: [[0; CHUNK]; ROTATED],
+            rfx: [[0.0; CHUNK]; ROTATED],
+            rfy: [[0.0; CHUNK]; ROTATED],
+            rtap: [0; ROTATED],
+            rot3: [0.0; FLOATS + 1],
+            cx: [0.0; CHUNK],
+            cy: [0.0; CHUNK],
             rdx: [0.0; CHUNK],
             rdy: [0.0; CHUNK],
-            fx: [0.0; CHUNK],
-            fy: [0.0; CHUNK],
+
             j: [[0; CHUNK]; 4],
             acc: [0.0; FLOATS],
         })
@@ -303,19 +374,22 @@ pub(super) fn row<const VERTICAL: bool, const JITTER: bool>(
     out: RowOut,
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
-    if !ctx.baseline && std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU was just checked to support AVX2, the only requirement of calling
-        // a function compiled with `target_feature(enable = "avx2")`.
+    if !ctx.baseline
+        && std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+    {
+        // SAFETY: the CPU was just checked to support AVX2 and FMA, the only requirement of
+        // calling a function compiled with `target_feature(enable = "avx2,fma")`.
         return unsafe { row_avx2::<VERTICAL, JITTER>(pass, ctx, lanes, y, out) };
     }
-    row_any::<VERTICAL, JITTER>(pass, ctx, lanes, y, out)
+    row_any::<VERTICAL, JITTER, Separate>(pass, ctx, lanes, y, out)
 }
 
-/// [`row_any`] compiled for AVX2: twice the vector width of the x86-64 baseline (SSE2). The
-/// arithmetic is the same IEEE operations in the same order (Rust never fuses a multiply and
-/// an add), so the result is identical.
+/// [`row_any`] compiled for AVX2 and FMA: twice the vector width of the x86-64 baseline
+/// (SSE2), and each multiply-add fused ([`Fused`]), so its results differ from the baseline
+/// build's by rounding (a few units in the last place of each sum).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 fn row_avx2<const VERTICAL: bool, const JITTER: bool>(
     pass: &Pass,
     ctx: &Ctx,
@@ -323,11 +397,57 @@ fn row_avx2<const VERTICAL: bool, const JITTER: bool>(
     y: usize,
     out: RowOut,
 ) -> usize {
-    row_any::<VERTICAL, JITTER>(pass, ctx, lanes, y, out)
+    row_any::<VERTICAL, JITTER, Fused>(pass, ctx, lanes, y, out)
+}
+
+/// How the chunk loops multiply and add: `a · b + c` fused (one rounding, where the CPU has
+/// FMA) or as two operations (the baseline build, where a fused multiply-add would be a
+/// library call).
+pub(super) trait MulAdd {
+    /// Whether this is the AVX2 + FMA build ([`Fused`], only used by `row_avx2`, after the
+    /// CPU check).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    const AVX2: bool;
+    /// a · b + c.
+    fn fma(a: f32, b: f32, c: f32) -> f32;
+    /// ⌊x⌋ for |x| < 2²² (exact either way: one rounding instruction where the build has
+    /// SSE4.1, else [`floor_small`]).
+    fn floor(x: f32) -> f32;
+}
+
+/// [`MulAdd`] as one fused operation ([`f32::mul_add`]).
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+pub(super) struct Fused;
+
+/// [`MulAdd`] as a multiply and an add.
+pub(super) struct Separate;
+
+impl MulAdd for Fused {
+    const AVX2: bool = true;
+    #[inline(always)]
+    fn fma(a: f32, b: f32, c: f32) -> f32 {
+        a.mul_add(b, c)
+    }
+    #[inline(always)]
+    fn floor(x: f32) -> f32 {
+        x.floor()
+    }
+}
+
+impl MulAdd for Separate {
+    const AVX2: bool = false;
+    #[inline(always)]
+    fn fma(a: f32, b: f32, c: f32) -> f32 {
+        a * b + c
+    }
+    #[inline(always)]
+    fn floor(x: f32) -> f32 {
+        floor_small(x)
+    }
 }
 
 #[inline(always)]
-fn row_any<const VERTICAL: bool, const JITTER: bool>(
+fn row_any<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     pass: &Pass,
     ctx: &Ctx,
     lanes: &mut Lanes,
@@ -338,7 +458,7 @@ fn row_any<const VERTICAL: bool, const JITTER: bool>(
     let (mut x0, mut fast) = (0, 0);
     while x0 < w {
         let n = CHUNK.min(w - x0);
-        if chunk::<VERTICAL, JITTER>(pass, ctx, lanes, x0, y, n) {
+        if chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, x0, y, n) {
             store(&mut out, &lanes.acc[..3 * n], x0);
             fast += n;
         } else {
@@ -347,7 +467,7 @@ fn row_any<const VERTICAL: bool, const JITTER: bool>(
             let mut s0 = x0;
             while s0 < x0 + n {
                 let k = SUBCHUNK.min(x0 + n - s0);
-                if chunk::<VERTICAL, JITTER>(pass, ctx, lanes, s0, y, k) {
+                if chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, s0, y, k) {
                     store(&mut out, &lanes.acc[..3 * k], s0);
                     fast += k;
                 } else {
@@ -405,9 +525,12 @@ fn spread3(src: &[f32], dst: &mut [f32]) {
     let mut blocks = dst.chunks_exact_mut(24);
     let mut sources = src.chunks_exact(8);
     for (d, s) in (&mut blocks).zip(&mut sources) {
-        let s: &[f32; 8] = s.try_into().expect("8 values");
+        let s: [f32; 8] = s.try_into().expect("8 values");
         let d: &mut [f32; 24] = d.try_into().expect("24 values");
-        *d = std::array::from_fn(|i| s[i / 3]);
+        *d = [
+            s[0], s[0], s[0], s[1], s[1], s[1], s[2], s[2], s[2], s[3], s[3], s[3], s[4], s[4],
+            s[4], s[5], s[5], s[5], s[6], s[6], s[6], s[7], s[7], s[7],
+        ];
     }
     for (d, &s) in blocks
         .into_remainder()
@@ -428,30 +551,19 @@ fn texel4(src: &[f32], j: u32) -> [f32; 4] {
     }
 }
 
+/// Floats `i..i + 8` of a flat image (zeros past its end).
 #[inline(always)]
-fn splat(v: f32) -> [f32; 4] {
-    [v; 4]
-}
-
-#[inline(always)]
-fn add4(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
-}
-
-#[inline(always)]
-fn sub4(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]]
-}
-
-#[inline(always)]
-fn mul4(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
-    [a[0] * b[0], a[1] * b[1], a[2] * b[2], a[3] * b[3]]
+fn load8(src: &[f32], i: usize) -> [f32; 8] {
+    match src.get(i..).and_then(|s| s.first_chunk::<8>()) {
+        Some(v) => *v,
+        None => std::array::from_fn(|k| src.get(i + k).copied().unwrap_or(0.0)),
+    }
 }
 
 /// The fast path for the `n` pixels of row `y` from column `x0`: true with their values in
 /// `lanes.acc`, or false when the chunk needs the per-pixel path.
 #[inline(always)]
-fn chunk<const VERTICAL: bool, const JITTER: bool>(
+fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     pass: &Pass,
     ctx: &Ctx,
     lanes: &mut Lanes,
@@ -521,11 +633,14 @@ fn chunk<const VERTICAL: bool, const JITTER: bool>(
     for l in 0..n {
         lanes.px[l] = x0f + lanes.lane[l];
     }
+
     if JITTER {
+        // The pass's rotated axis (c, s), or (−s, c) for the vertical pass (whose −s is
+        // applied as an added product: x − o·(−s) = x + o·s, the same bits).
         let rot = &ctx.table.rotation[i0..i0 + n];
         for l in 0..n {
             let (c, s) = pass.rotations[rot[l] as usize];
-            (lanes.rdx[l], lanes.rdy[l]) = if VERTICAL { (-s, c) } else { (c, s) };
+            (lanes.rdx[l], lanes.rdy[l]) = if VERTICAL { (s, c) } else { (c, s) };
         }
     }
     lanes.acc[..m].fill(0.0);
@@ -533,92 +648,126 @@ fn chunk<const VERTICAL: bool, const JITTER: bool>(
     let step = usize::from(!VERTICAL);
     let lim = if VERTICAL { hmax } else { wmax };
     let t = pass.taps;
+    // Rotated taps whose cells are all inside the image: their positions are kept (in
+    // `lanes.rj`, `rfx`, `rfy`, `rtap`) and summed after the other taps, per pixel.
+    let mut inside = 0;
     for (k, (&o_mm, wt)) in t.offset.iter().zip(&t.weight).enumerate() {
         let pattern = &taps.pattern[k][..m];
         if o_mm == 0.0 {
             // The centre tap reads the pixel itself.
             let s = &src[3 * i0..3 * i0 + m];
             for i in 0..m {
-                lanes.acc[i] += pattern[i] * s[i];
+                lanes.acc[i] = A::fma(pattern[i], s[i], lanes.acc[i]);
             }
         } else if JITTER && o_mm.abs() <= pass.rotate_limit_mm {
             // Rotated tap: a bilinear read at p − o·dir. Positions and cells for all pixels,
-            // then per pixel four 4-float reads and the blend.
+            // then per pixel the reads and the blend.
+            if inside == ROTATED {
+                rotated_sums::<A>(lanes, taps, src, w, n, inside);
+                inside = 0;
+            }
             let (wf, hf) = (wmax as f32, hmax as f32);
-            for l in 0..n {
-                let o = o_mm * lanes.inv[l];
-                let (sx, sy) = (lanes.px[l] - o * lanes.rdx[l], yf - o * lanes.rdy[l]);
-                let (cx, cy) = (floor_small(sx), floor_small(sy));
-                lanes.fx[l] = sx - cx;
-                lanes.fy[l] = sy - cy;
-                let (cx0, cx1) = (
-                    small_u32(cx.clamp(0.0, wf)),
-                    small_u32((cx + 1.0).clamp(0.0, wf)),
-                );
-                let (cy0, cy1) = (
-                    small_u32(cy.clamp(0.0, hf)) * w as u32,
-                    small_u32((cy + 1.0).clamp(0.0, hf)) * w as u32,
-                );
-                lanes.j[0][l] = cy0 + cx0;
-                lanes.j[1][l] = cy0 + cx1;
-                lanes.j[2][l] = cy1 + cx0;
-                lanes.j[3][l] = cy1 + cx1;
-            }
-            // Per pixel: the four texels as 4-float reads (RGB and one float past it,
-            // unused), blended in one 4-wide vector; the sums are updated in a second loop
-            // (in place, 4-float stores overlapping the next pixel's would stall the loads
-            // behind them).
-            let w4 = [wt[0], wt[1], wt[2], 0.0];
-            for l in 0..n {
-                let a0 = texel4(src, lanes.j[0][l]);
-                let a1 = texel4(src, lanes.j[1][l]);
-                let b0 = texel4(src, lanes.j[2][l]);
-                let b1 = texel4(src, lanes.j[3][l]);
-                let (fx, fy) = (splat(lanes.fx[l]), splat(lanes.fy[l]));
-                let top = add4(a0, mul4(fx, sub4(a1, a0)));
-                let bottom = add4(b0, mul4(fx, sub4(b1, b0)));
-                lanes.term4[l] = mul4(w4, add4(top, mul4(fy, sub4(bottom, top))));
-            }
-            for (a, t) in lanes.acc[..m].chunks_exact_mut(3).zip(&lanes.term4) {
-                (a[0], a[1], a[2]) = (a[0] + t[0], a[1] + t[1], a[2] + t[2]);
+            let edge = rotated_cells::<VERTICAL, A>(
+                (o_mm, yf, w, wf, hf),
+                &lanes.inv[..n],
+                (&lanes.px[..n], &lanes.rdx[..n], &lanes.rdy[..n]),
+                &mut lanes.rj[inside][..n],
+                (&mut lanes.rfx[inside][..n], &mut lanes.rfy[inside][..n]),
+                (&mut lanes.cx[..n], &mut lanes.cy[..n]),
+            );
+            if !edge {
+                lanes.rtap[inside] = k;
+                inside += 1;
+            } else {
+                // Near the border: the four clamped texels of each pixel, as the per-pixel
+                // form reads them.
+                for l in 0..n {
+                    let (cx, cy) = (lanes.cx[l], lanes.cy[l]);
+                    let (cx0, cx1) = (
+                        small_u32(cx.clamp(0.0, wf)),
+                        small_u32((cx + 1.0).clamp(0.0, wf)),
+                    );
+                    let (cy0, cy1) = (
+                        small_u32(cy.clamp(0.0, hf)) * w as u32,
+                        small_u32((cy + 1.0).clamp(0.0, hf)) * w as u32,
+                    );
+                    lanes.j[0][l] = cy0 + cx0;
+                    lanes.j[1][l] = cy0 + cx1;
+                    lanes.j[2][l] = cy1 + cx0;
+                    lanes.j[3][l] = cy1 + cx1;
+                }
+                for l in 0..n {
+                    let a0 = texel4(src, lanes.j[0][l]);
+                    let a1 = texel4(src, lanes.j[1][l]);
+                    let b0 = texel4(src, lanes.j[2][l]);
+                    let b1 = texel4(src, lanes.j[3][l]);
+                    let (fx, fy) = (lanes.rfx[inside][l], lanes.rfy[inside][l]);
+                    for c in 0..3 {
+                        let top = A::fma(fx, a1[c] - a0[c], a0[c]);
+                        let bottom = A::fma(fx, b1[c] - b0[c], b0[c]);
+                        let a = &mut lanes.acc[3 * l + c];
+                        *a = A::fma(wt[c], A::fma(fy, bottom - top, top), *a);
+                    }
+                }
             }
         } else {
-            // Axis-aligned tap: a linear read at p − o along the axis.
-            // Per pixel, then the fractions repeated over the channels.
+            // Axis-aligned tap: a linear read at p − o along the axis. Positions per pixel
+            // (the per-pixel form's f32 operations, so the same values), then the fractions
+            // repeated over the channels.
             for l in 0..n {
                 let o = o_mm * lanes.inv[l];
                 let p = if VERTICAL { yf } else { lanes.px[l] } - o;
-                let p0 = floor_small(p);
-                lanes.fx[l] = p - p0;
-                lanes.cell[l] = p0 - lanes.lane[l] * step as f32;
+                let p0 = A::floor(p);
+                lanes.frac[l] = p - p0;
+                // The first texel's coordinate minus the pixel's own offset in the chunk (one
+                // value for the whole chunk unless the footprint changes across it), as the
+                // bits of cell + 2²³: monotonic for |cell| < 2²², so its range is an integer
+                // fold, which vectorises where a float comparison fold does not.
+                lanes.key[l] = (p0 - lanes.lane[l] * step as f32 + 8_388_608.0).to_bits();
             }
-            spread3(&lanes.fx[..n], &mut lanes.frac3[..m]);
-            // cell is the first texel's coordinate minus the pixel's own offset in the
-            // chunk: one value for the whole chunk unless the footprint changes across it.
-            let cells = &lanes.cell[..n];
-            let c0f = cells[0];
-            // Equal floats here have equal bits (no −0, no NaN): an integer OR reduction,
-            // which vectorises where a float comparison fold does not.
-            let differ = cells
+            spread3(&lanes.frac[..n], &mut lanes.frac3[..m]);
+            let (kmin, kmax) = lanes.key[..n]
                 .iter()
-                .fold(0u32, |a, &c| a | (c.to_bits() ^ c0f.to_bits()));
-            let c0 = c0f as i32;
-            let last = c0 + (n - 1) as i32 * step as i32 + 1;
+                .fold((u32::MAX, 0u32), |(lo, hi), &k| (lo.min(k), hi.max(k)));
+            let c0 = (f32::from_bits(kmin) - 8_388_608.0) as i32;
+            let spread = kmax - kmin;
+            let last = c0 + spread as i32 + (n - 1) as i32 * step as i32 + 1;
             let frac = &lanes.frac3[..m];
-            if differ == 0 && c0 >= 0 && last <= lim {
-                let first = if VERTICAL {
-                    c0 as usize * w + x0
-                } else {
-                    y * w + c0 as usize
-                };
-                let next = first + if VERTICAL { w } else { 1 };
-                let (s0, s1) = (&src[3 * first..3 * first + m], &src[3 * next..3 * next + m]);
+            let first = if VERTICAL {
+                c0.max(0) as usize * w + x0
+            } else {
+                y * w + c0.max(0) as usize
+            };
+            let next = if VERTICAL { w } else { 1 };
+            if spread == 0 && c0 >= 0 && last <= lim {
+                // One offset: two contiguous runs of the source.
+                let s0 = &src[3 * first..3 * first + m];
+                let s1 = &src[3 * (first + next)..3 * (first + next) + m];
                 for i in 0..m {
-                    lanes.acc[i] += pattern[i] * (s0[i] + frac[i] * (s1[i] - s0[i]));
+                    let v = A::fma(frac[i], s1[i] - s0[i], s0[i]);
+                    lanes.acc[i] = A::fma(pattern[i], v, lanes.acc[i]);
+                }
+            } else if spread == 1 && c0 >= 0 && last <= lim {
+                // Two offsets (the footprint changes across the chunk): three contiguous runs,
+                // each pixel blending the first two or the last two.
+                for l in 0..n {
+                    lanes.hi[l] = f32::from(u8::from(lanes.key[l] != kmin));
+                }
+                spread3(&lanes.hi[..n], &mut lanes.hi3[..m]);
+                let hi = &lanes.hi3[..m];
+                let s0 = &src[3 * first..3 * first + m];
+                let s1 = &src[3 * (first + next)..3 * (first + next) + m];
+                let s2 = &src[3 * (first + 2 * next)..3 * (first + 2 * next) + m];
+                for i in 0..m {
+                    let up = hi[i] != 0.0;
+                    let (a, b) = if up { (s1[i], s2[i]) } else { (s0[i], s1[i]) };
+                    let v = A::fma(frac[i], b - a, a);
+                    lanes.acc[i] = A::fma(pattern[i], v, lanes.acc[i]);
                 }
             } else {
                 for l in 0..n {
-                    let p0 = lanes.cell[l] as i32 + (l * step) as i32;
+                    let cell = f32::from_bits(lanes.key[l]) - 8_388_608.0;
+                    let p0 = cell as i32 + (l * step) as i32;
                     let (q0, q1) = (p0.clamp(0, lim) as usize, (p0 + 1).clamp(0, lim) as usize);
                     let (j0, j1) = if VERTICAL {
                         (q0 * w + x0 + l, q1 * w + x0 + l)
@@ -627,11 +776,194 @@ fn chunk<const VERTICAL: bool, const JITTER: bool>(
                     };
                     for c in 0..3 {
                         let (s0, s1) = (src[3 * j0 + c], src[3 * j1 + c]);
-                        lanes.acc[3 * l + c] += wt[c] * (s0 + frac[3 * l] * (s1 - s0));
+                        let v = A::fma(frac[3 * l], s1 - s0, s0);
+                        lanes.acc[3 * l + c] = A::fma(wt[c], v, lanes.acc[3 * l + c]);
                     }
                 }
             }
         }
     }
+    if inside > 0 {
+        rotated_sums::<A>(lanes, taps, src, w, n, inside);
+    }
     true
+}
+
+/// Adds the first `inside` rotated taps held in `lanes` (cells inside the image) to the
+/// chunk's sums, per pixel: each cell's two texels of a row are six contiguous floats, read
+/// as one 8-float load per row. The row pair is blended along y first, then weighted by
+/// [(1 − fx)·wt, fx·wt, 0, 0] (as 8 lanes) and summed over the taps in registers; the halves
+/// are folded and written as 4 floats that overlap the next pixel's (in order, so each keeps
+/// its 3), then added.
+#[inline(always)]
+fn rotated_sums<A: MulAdd>(
+    lanes: &mut Lanes,
+    taps: &ChunkTaps,
+    src: &[f32],
+    w: usize,
+    n: usize,
+    inside: usize,
+) {
+    let down = 3 * w;
+    let n = n.min(CHUNK);
+    let inside = inside.min(ROTATED);
+    let (rj, rfx, rfy) = (
+        &lanes.rj[..inside],
+        &lanes.rfx[..inside],
+        &lanes.rfy[..inside],
+    );
+    let rtap = &lanes.rtap[..inside];
+    let rot3 = &mut lanes.rot3;
+    #[cfg(target_arch = "x86_64")]
+    if A::AVX2 {
+        let mut w8: [RowWeights; ROTATED] = [([0.0; 8], [0.0; 8]); ROTATED];
+        for (q, &k) in rtap.iter().enumerate() {
+            w8[q] = (taps.rot_lo[k], taps.rot_d[k]);
+        }
+        // SAFETY: `A::AVX2` is only true for `Fused`, which only `row_avx2` uses, after
+        // checking that the CPU has AVX2 and FMA.
+        unsafe {
+            rotated_pixels_avx2(
+                (&lanes.rj, &lanes.rfx, &lanes.rfy),
+                (&w8, inside),
+                src,
+                down,
+                rot3,
+                n,
+            )
+        };
+        for i in 0..3 * n {
+            lanes.acc[i] += lanes.rot3[i];
+        }
+        return;
+    }
+    for l in 0..n {
+        let mut r = [0.0f32; 8];
+        for q in 0..inside {
+            let j = 3 * rj[q][l] as usize;
+            let (a, b) = (load8(src, j), load8(src, j + down));
+            let (fx, fy) = (rfx[q][l], rfy[q][l]);
+            let k = rtap[q];
+            let (wlo, wd) = (&taps.rot_lo[k], &taps.rot_d[k]);
+            let v: [f32; 8] = std::array::from_fn(|i| A::fma(fy, b[i] - a[i], a[i]));
+            let x: [f32; 8] = std::array::from_fn(|i| A::fma(fx, wd[i], wlo[i]));
+            r = std::array::from_fn(|i| A::fma(x[i], v[i], r[i]));
+        }
+        // (The fourth float, overwritten by the next pixel's, folds the two spare lanes: it
+        // keeps all eight lanes live, so the compiler reads them as one vector.)
+        let v = [r[0] + r[3], r[1] + r[4], r[2] + r[5], r[6] + r[7]];
+        rot3[3 * l..3 * l + 4].copy_from_slice(&v);
+    }
+    for i in 0..3 * n {
+        lanes.acc[i] += lanes.rot3[i];
+    }
+}
+
+/// A rotated tap's cells for the chunk's pixels (`rdx` holds −(the x direction) in the
+/// vertical pass): `rj` the first texel (unclamped),
+/// `f` the bilinear fractions, `c` the floored positions; returns whether a cell reaches past
+/// the border (then `rj` is not valid). Separate arguments, so the compiler knows the arrays
+/// do not overlap and vectorises the loop.
+#[inline(always)]
+fn rotated_cells<const VERTICAL: bool, A: MulAdd>(
+    (o_mm, yf, w, wf, hf): (f32, f32, usize, f32, f32),
+    inv: &[f32],
+    (px, rdx, rdy): (&[f32], &[f32], &[f32]),
+    rj: &mut [u32],
+    (rfx, rfy): (&mut [f32], &mut [f32]),
+    (cxs, cys): (&mut [f32], &mut [f32]),
+) -> bool {
+    let n = inv.len();
+    let (px, rdx, rdy) = (&px[..n], &rdx[..n], &rdy[..n]);
+    let (rj, rfx, rfy, cxs, cys) = (
+        &mut rj[..n],
+        &mut rfx[..n],
+        &mut rfy[..n],
+        &mut cxs[..n],
+        &mut cys[..n],
+    );
+    let mut edge = 0u32;
+    for l in 0..n {
+        let o = o_mm * inv[l];
+        let sx = if VERTICAL {
+            px[l] + o * rdx[l]
+        } else {
+            px[l] - o * rdx[l]
+        };
+        let sy = yf - o * rdy[l];
+        let (cx, cy) = (A::floor(sx), A::floor(sy));
+        rfx[l] = sx - cx;
+        rfy[l] = sy - cy;
+        edge |= u32::from(cx < 0.0) | u32::from(cx >= wf);
+        edge |= u32::from(cy < 0.0) | u32::from(cy >= hf);
+        cxs[l] = cx;
+        cys[l] = cy;
+        // Through the bits of c + 2²³ (wrapping where c < 0: then `edge` is set).
+        let bits = |c: f32| (c + 8_388_608.0).to_bits().wrapping_sub(0x4B00_0000);
+        rj[l] = bits(cx).wrapping_add(bits(cy).wrapping_mul(w as u32));
+    }
+    edge != 0
+}
+
+/// The per-pixel loop of [`rotated_sums`] in AVX2 + FMA intrinsics: the same operations as the
+/// portable loop, on one 8-lane register per row (the compiler splits the portable loop's
+/// 8-float arrays into 4-lane halves with inserts and bounds checks, about twice the
+/// instructions). The reads are raw 8-float loads after one check per chunk that every one
+/// is inside `src`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn rotated_pixels_avx2(
+    (rj, rfx, rfy): (&Slots<u32>, &Slots<f32>, &Slots<f32>),
+    (w8, inside): (&[RowWeights; ROTATED], usize),
+    src: &[f32],
+    down: usize,
+    rot3: &mut [f32; FLOATS + 1],
+    n: usize,
+) {
+    use std::arch::x86_64::*;
+    let (inside, n) = (inside.min(ROTATED), n.min(CHUNK));
+    let jmax = rj[..inside]
+        .iter()
+        .map(|r| r[..n].iter().fold(0u32, |a, &j| a.max(j)))
+        .max()
+        .unwrap_or(0);
+    let inbounds = (3 * jmax as usize)
+        .checked_add(down + 8)
+        .is_some_and(|end| end <= src.len());
+    let mut wv = [(_mm256_setzero_ps(), _mm256_setzero_ps()); ROTATED];
+    for (q, (lo, d)) in w8.iter().enumerate() {
+        // SAFETY: each array holds 8 floats.
+        wv[q] = unsafe { (_mm256_loadu_ps(lo.as_ptr()), _mm256_loadu_ps(d.as_ptr())) };
+    }
+    let fold = _mm256_setr_epi32(3, 4, 5, 6, 7, 7, 7, 7);
+    let base = src.as_ptr();
+    for l in 0..n {
+        let mut r = _mm256_setzero_ps();
+        for q in 0..inside {
+            let j = 3 * rj[q][l] as usize;
+            let (a, b) = if inbounds {
+                // SAFETY: j + down + 8 ≤ src.len() for every pixel and tap of the chunk
+                // (`inbounds`).
+                unsafe {
+                    (
+                        _mm256_loadu_ps(base.add(j)),
+                        _mm256_loadu_ps(base.add(j + down)),
+                    )
+                }
+            } else {
+                let (a, b) = (load8(src, j), load8(src, j + down));
+                // SAFETY: local arrays of 8 floats.
+                unsafe { (_mm256_loadu_ps(a.as_ptr()), _mm256_loadu_ps(b.as_ptr())) }
+            };
+            let v = _mm256_fmadd_ps(_mm256_set1_ps(rfy[q][l]), _mm256_sub_ps(b, a), a);
+            let x = _mm256_fmadd_ps(_mm256_set1_ps(rfx[q][l]), wv[q].1, wv[q].0);
+            r = _mm256_fmadd_ps(x, v, r);
+        }
+        // Lanes 0..3 + lanes 3..6: RGB of the left column plus the right one (the fourth
+        // float, overwritten by the next pixel's, is unused).
+        let sum = _mm256_add_ps(r, _mm256_permutevar8x32_ps(r, fold));
+        let out = &mut rot3[3 * l..3 * l + 4];
+        // SAFETY: `out` holds 4 floats.
+        unsafe { _mm_storeu_ps(out.as_mut_ptr(), _mm256_castps256_ps128(sum)) };
+    }
 }
