@@ -359,6 +359,134 @@ fn shading_a_subset_equals_the_full_render_there() {
     assert!(err.contains("past the image"), "{err}");
 }
 
+/// The baselines' `shade_pixels` give a pixel subset exactly the values and standard errors a
+/// full render gives those pixels, bit for bit with 1 and 2 threads, with importance-sampled
+/// and uniform points, in the order asked; they refuse a pixel past the image. Another
+/// `stream` draws other points (the values change), and `vpl_seed` equal to the frame's seed
+/// changes nothing.
+#[test]
+fn baseline_subsets_equal_the_full_render_there() {
+    use sss_render::integrators::baseline::PointOptions;
+    use sss_render::integrators::eelc::Eelc;
+    use sss_render::integrators::manylight::PixelResult;
+    use sss_render::integrators::mdlc::Mdlc;
+    let mut s = scene("sphere", 20, 15);
+    s.camera.pixel_samples = 2;
+    let settings = RenderSettings::default();
+    let frame = Frame::prepare(&s, settings.seed);
+    let pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+    };
+    for uniform in [false, true] {
+        let points = PointOptions {
+            irradiance_points: 48,
+            uniform,
+            ..PointOptions::default()
+        };
+        let mdlc = Mdlc { eps: 0.05, points };
+        let eelc = Eelc {
+            eps: 0.05,
+            points,
+            ..Eelc::default()
+        };
+        type Subset<'a> = Box<dyn Fn(&[usize], PointOptions) -> Vec<PixelResult> + Sync + 'a>;
+        let methods: [(&str, &dyn sss_render::integrators::Integrator, Subset<'_>); 2] = [
+            (
+                "mdlc",
+                &mdlc,
+                Box::new(|p: &[usize], points| {
+                    Mdlc { points, ..mdlc }.shade_pixels(&frame, p).unwrap()
+                }),
+            ),
+            (
+                "eelc",
+                &eelc,
+                Box::new(|p: &[usize], points| {
+                    Eelc { points, ..eelc }.shade_pixels(&frame, p).unwrap()
+                }),
+            ),
+        ];
+        for (name, m, subset) in &methods {
+            let full = render(&s, *m, &settings, &NoProgress).unwrap();
+            let lit: Vec<usize> = (0..full.subsurface.len())
+                .filter(|&i| lum(full.subsurface[i]) > 0.0)
+                .collect();
+            assert!(lit.len() > 40, "{name}: {} lit pixels", lit.len());
+            let black = (0..full.subsurface.len())
+                .find(|&i| lum(full.subsurface[i]) == 0.0)
+                .unwrap();
+            let mut pick: Vec<usize> = lit.iter().copied().step_by(5).rev().collect();
+            pick.push(black);
+            let pairs = full.layer("pairs").unwrap();
+            for threads in [1, 2] {
+                let sub = pool(threads).install(|| subset(&pick, points));
+                assert_eq!(sub.len(), pick.len());
+                for (r, &i) in sub.iter().zip(&pick) {
+                    let what = format!("{name} uniform={uniform} threads={threads} pixel {i}");
+                    let bits = |v: [f64; 3]| v.map(f64::to_bits);
+                    assert_eq!(bits(r.subsurface), bits(full.subsurface[i]), "{what}");
+                    match &full.std_error {
+                        Some(se) => assert_eq!(bits(r.std_error), bits(se[i]), "{what}"),
+                        None => assert_eq!(r.std_error, [0.0; 3], "{what}"),
+                    }
+                    assert_eq!(r.triplets, pairs[i][0], "{what}");
+                }
+                assert_eq!(sub.last().unwrap().subsurface, [0.0; 3]);
+                assert!(sub.iter().any(|r| r.triplets > 1.0), "{name}");
+            }
+            // Another stream: other points, so other values on the lit pixels; the VPLs drawn
+            // from the frame's own seed: the same bits.
+            let other = subset(
+                &pick,
+                PointOptions {
+                    stream: 7,
+                    ..points
+                },
+            );
+            let same = subset(
+                &pick,
+                PointOptions {
+                    vpl_seed: Some(settings.seed),
+                    ..points
+                },
+            );
+            let differ = other
+                .iter()
+                .zip(&pick)
+                .filter(|(r, i)| r.subsurface != full.subsurface[**i])
+                .count();
+            assert!(
+                differ >= pick.len() - 2,
+                "{name}: {differ} of {} differ",
+                pick.len()
+            );
+            for (r, &i) in same.iter().zip(&pick) {
+                assert_eq!(r.subsurface, full.subsurface[i], "{name} vpl_seed");
+            }
+            let n = full.subsurface.len();
+            let err = Mdlc { points, ..mdlc }
+                .shade_pixels(&frame, &[n])
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("past the image") && err.contains("mdlc"),
+                "{err}"
+            );
+            let err = Eelc { points, ..eelc }
+                .shade_pixels(&frame, &[0, n + 3])
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("past the image") && err.contains("eelc"),
+                "{err}"
+            );
+        }
+    }
+}
+
 /// A square diffuse floor of side 2a under a light, and a small skin sphere standing on it.
 fn floor_scene(light: &str, albedo: f64) -> Scene {
     let text = format!(

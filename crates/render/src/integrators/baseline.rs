@@ -45,7 +45,10 @@
 //! time each took, so the importance sampling's share (88–96 % of EELC's time in the paper's
 //! Table 2) can be read off.
 
-use super::manylight::{ObjectData, light_tree_seeded, model_error, object_data, scene_box};
+use super::manylight::{
+    ObjectData, PixelResult, estimate_seed, light_tree_seeded, model_error, object_data,
+    pixel_list, pixel_result, scene_box, shadow_test, stream_seed,
+};
 use super::pathtrace::{DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch};
 use super::single_tree::check_radial;
 use super::{Layer, MethodOptions, OptionKind, OptionSpec, Shaded, Stat};
@@ -54,14 +57,13 @@ use crate::frame::Frame;
 use crate::progress::Progress;
 use crate::rng::{Stream, rng};
 use crate::vpls::vpl_count;
-use glam::DVec3;
 use rand::RngExt;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
 use sss_manylight::irradiance_cluster::IcNode;
 use sss_manylight::{
     GatherPoint, GatherTree, IrradiancePoint, LightNode, LightTree, PixelEstimate, ShadingPoint,
-    Summary, Triangle, Visibility, Vpl, gather_points, pixel_seed, uniform_points,
+    Summary, Triangle, Visibility, Vpl, gather_points, uniform_points,
 };
 use sss_scene::Scene;
 use std::time::Instant;
@@ -107,6 +109,17 @@ pub struct PointOptions {
     pub vpls: u32,
     /// Cap on the pairs per pixel and object.
     pub max_pairs: usize,
+    /// Seed of the VPL sampling (`None`: the render's seed), as [`ManyLight::vpl_seed`]:
+    /// fixing it keeps one VPL set, and so one integral, across renders of different seeds.
+    ///
+    /// [`ManyLight::vpl_seed`]: super::manylight::ManyLight::vpl_seed
+    pub vpl_seed: Option<u64>,
+    /// Mixed into the seeds of the irradiance points and of every pixel estimate (0 by
+    /// default), as [`ManyLight::stream`]: another stream gives an independent estimate (new
+    /// points, new strata samples) over the same G-buffer and VPLs.
+    ///
+    /// [`ManyLight::stream`]: super::manylight::ManyLight::stream
+    pub stream: u64,
 }
 
 impl Default for PointOptions {
@@ -116,6 +129,8 @@ impl Default for PointOptions {
             uniform: false,
             vpls: 1024,
             max_pairs: 200_000,
+            vpl_seed: None,
+            stream: 0,
         }
     }
 }
@@ -144,6 +159,8 @@ impl PointOptions {
             uniform: o.flag(UNIFORM_POINTS.name),
             vpls,
             max_pairs,
+            vpl_seed: None,
+            stream: 0,
         })
     }
 
@@ -214,13 +231,18 @@ pub(crate) struct Prepared {
     pub(crate) g_max: f64,
 }
 
-/// Builds the per-frame data, refusing the directional dipole and pre-scatter textures with
-/// the errors of `manylight`.
-pub(crate) fn prepare(frame: &Frame<'_>, method: &str, vpls: u32) -> Result<Prepared, Error> {
+/// Builds the per-frame data (the VPLs from `opts.vpl_seed`, else the frame's seed), refusing
+/// the directional dipole and pre-scatter textures with the errors of `manylight`.
+pub(crate) fn prepare(
+    frame: &Frame<'_>,
+    method: &str,
+    opts: &PointOptions,
+) -> Result<Prepared, Error> {
     check_radial(frame, method)?;
     let objects = frame.timed("irradiance_tree", || object_data(frame, method))?;
+    let vpl_seed = opts.vpl_seed.unwrap_or(frame.seed);
     let lights = frame.timed("light_tree", || {
-        light_tree_seeded(frame, vpls, 0, frame.seed)
+        light_tree_seeded(frame, opts.vpls, 0, vpl_seed)
     })?;
     let (_, half_diag) = scene_box(frame);
     Ok(Prepared {
@@ -228,6 +250,28 @@ pub(crate) fn prepare(frame: &Frame<'_>, method: &str, vpls: u32) -> Result<Prep
         lights,
         g_max: sss_manylight::Settings::g_max_for_scene(half_diag),
     })
+}
+
+/// The per-object estimators (indexed by object; `None` for an object without data, and for
+/// every object when the frame has no light), each made by `make` from the light tree and the
+/// object's data; its errors name `method`.
+pub(crate) fn estimators<'a, E>(
+    prepared: &'a Prepared,
+    method: &str,
+    make: impl Fn(&'a LightTree, &'a ObjectData) -> Result<E, sss_manylight::Error>,
+) -> Result<Vec<Option<E>>, Error> {
+    let Some(lt) = &prepared.lights else {
+        return Ok(prepared.objects.iter().map(|_| None).collect());
+    };
+    prepared
+        .objects
+        .iter()
+        .map(|d| {
+            d.as_ref()
+                .map(|d| make(lt, d).map_err(|e| Error::Input(format!("{method}: {e}"))))
+                .transpose()
+        })
+        .collect()
 }
 
 /// One pixel's output.
@@ -242,18 +286,23 @@ struct PixelOut {
     seconds_estimate: f64,
 }
 
-/// Runs the per-pixel pipeline with the per-object estimators `estimators` (indexed by object)
-/// and assembles the method's output.
-pub(crate) fn run<E: PixelEstimator>(
+/// The estimates of the pixels `only` of `frame` (all pixels when `None`), in that order, with
+/// the largest probe-missed energy; records the stages `points` and `shading`. Shared by
+/// [`run`] and [`shade_pixels`]: every pixel's points and estimate are seeded by its own index,
+/// so a pixel gets the same bits either way.
+fn estimate_pixels<E: PixelEstimator>(
     frame: &Frame<'_>,
     method: &'static str,
     opts: &PointOptions,
     prepared: &Prepared,
     estimators: &[Option<E>],
+    only: Option<&[usize]>,
     progress: &dyn Progress,
-) -> Result<Shaded, Error> {
+) -> Result<(Vec<PixelOut>, f64), Error> {
     let scene = frame.scene;
     let geom = &frame.geom;
+    let gb = &frame.gbuffer;
+    let list = pixel_list(frame, only, method)?;
     let radii: Vec<Option<ProbeRadii>> = frame
         .shading
         .iter()
@@ -268,27 +317,19 @@ pub(crate) fn run<E: PixelEstimator>(
         .flatten()
         .flat_map(|r| r.missed)
         .fold(0.0, f64::max);
-    let eps_ray = 16.0 * geom.epsilon();
     // Shadow rays from the gather point to the VPL, as `manylight`'s.
-    let visibility = |x: DVec3, y: DVec3| {
-        let d = y - x;
-        let dist = d.length();
-        if !(dist > 2.0 * eps_ray) {
-            return false;
-        }
-        !geom.occluded(x, d / dist, eps_ray, dist - eps_ray)
-    };
-    let gb = &frame.gbuffer;
+    let visibility = shadow_test(frame);
     let spp = gb.samples_per_pixel as f64;
     let gspp = gb.samples_per_pixel as u64;
     let n = opts.irradiance_points as usize;
+    let points_seed = stream_seed(frame.seed, opts.stream);
     let wall = Instant::now();
-    let pixels: Vec<PixelOut> = (0..gb.pixels())
-        .into_par_iter()
+    let pixels: Vec<PixelOut> = list
+        .par_iter()
         .with_min_len(4)
         .map_init(
             || (Scratch::default(), Vec::new(), Vec::new()),
-            |(scratch, points, gathered), i| {
+            |(scratch, points, gathered), &i| {
                 let samples = gb.pixel(i);
                 let mut out = PixelOut {
                     values: vec![[0.0; 3]; samples.len()],
@@ -326,7 +367,7 @@ pub(crate) fn run<E: PixelEstimator>(
                             weight: e / spp,
                         };
                         let mut r = rng(
-                            frame.seed,
+                            points_seed,
                             Stream::IrradiancePoints,
                             s.pixel as u64 * gspp + s.index as u64,
                         );
@@ -364,10 +405,7 @@ pub(crate) fn run<E: PixelEstimator>(
                         continue;
                     }
                     out.gather_points += gathered.len() as u64;
-                    let seed = pixel_seed(
-                        sss_util::splitmix64(frame.seed ^ sss_util::splitmix64(u64::from(o))),
-                        i as u64,
-                    );
+                    let seed = estimate_seed(frame.seed, o, opts.stream, i);
                     let tree = if gathered.is_empty() {
                         None
                     } else {
@@ -413,7 +451,22 @@ pub(crate) fn run<E: PixelEstimator>(
     let share = if tp + te > 0.0 { tp / (tp + te) } else { 0.0 };
     frame.record("points", wall * share);
     frame.record("shading", wall * (1.0 - share));
+    Ok((pixels, missed))
+}
 
+/// Runs the per-pixel pipeline over the whole frame with the per-object estimators
+/// `estimators` (indexed by object) and assembles the method's output.
+pub(crate) fn run<E: PixelEstimator>(
+    frame: &Frame<'_>,
+    method: &'static str,
+    opts: &PointOptions,
+    prepared: &Prepared,
+    estimators: &[Option<E>],
+    progress: &dyn Progress,
+) -> Result<Shaded, Error> {
+    let (pixels, missed) =
+        estimate_pixels(frame, method, opts, prepared, estimators, None, progress)?;
+    let gb = &frame.gbuffer;
     let mut summary = Summary::default();
     let mut values = Vec::with_capacity(gb.samples.len());
     let mut std_error = Vec::with_capacity(pixels.len());
@@ -466,4 +519,42 @@ pub(crate) fn run<E: PixelEstimator>(
             pixels: pairs,
         }],
     })
+}
+
+/// The estimates of the pixels `pixels` of `frame` only, in that order (the baselines'
+/// `shade_pixels`): each pixel's subsurface value and standard error equal what a full render
+/// gives it ([`run`]), since its points and estimate are seeded by its own index. `triplets`
+/// holds the pixel's pairs (MDLC's cut, EELC's strata); `std_error` is 0 without an interval
+/// (MDLC).
+pub(crate) fn shade_pixels<E: PixelEstimator>(
+    frame: &Frame<'_>,
+    method: &'static str,
+    opts: &PointOptions,
+    prepared: &Prepared,
+    estimators: &[Option<E>],
+    pixels: &[usize],
+) -> Result<Vec<PixelResult>, Error> {
+    let (outs, _) = estimate_pixels(
+        frame,
+        method,
+        opts,
+        prepared,
+        estimators,
+        Some(pixels),
+        &crate::progress::NoProgress,
+    )?;
+    Ok(outs
+        .into_iter()
+        .zip(pixels)
+        .map(|(o, &i)| {
+            pixel_result(
+                frame,
+                i,
+                &o.values,
+                o.var.map(f64::sqrt),
+                o.pairs,
+                o.summary,
+            )
+        })
+        .collect())
 }

@@ -15,9 +15,9 @@
 //! textures.
 
 use super::baseline::{
-    self, IRRADIANCE_POINTS, MAX_PAIRS, PixelEstimator, PointOptions, UNIFORM_POINTS,
+    self, IRRADIANCE_POINTS, MAX_PAIRS, PixelEstimator, PointOptions, Prepared, UNIFORM_POINTS,
 };
-use super::manylight::{MIN_TRIPLETS, OPTIONS as MANYLIGHT};
+use super::manylight::{MIN_TRIPLETS, OPTIONS as MANYLIGHT, PixelResult};
 use super::{Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep};
 use crate::Error;
 use crate::frame::Frame;
@@ -94,6 +94,39 @@ impl Eelc {
         s.min_pairs = MIN_TRIPLETS.min(self.points.max_pairs);
         s
     }
+
+    /// The Student-t quantiles of `--alpha`.
+    fn student_t(&self) -> Result<StudentT, Error> {
+        StudentT::new(self.alpha).map_err(|e| Error::Input(format!("--alpha: {e}")))
+    }
+
+    /// The per-object estimators of a prepared frame.
+    fn estimators<'a>(
+        &self,
+        prepared: &'a Prepared,
+        t: &'a StudentT,
+    ) -> Result<Vec<Option<EelcEstimator<'a>>>, Error> {
+        let settings = self.settings(prepared.g_max);
+        baseline::estimators(prepared, METHOD.name, |lt, d| {
+            EelcEstimator::new(lt, &d.ft, t, settings)
+        })
+    }
+
+    /// The estimates of the pixels `pixels` of `frame` only, in that order (for subset
+    /// references and error measurements): each pixel's subsurface value and standard error
+    /// (ΔI / t_α, against its own point set's value) equal what a full render gives it with the
+    /// same seed (its points and strata depend on its own index only); `triplets` holds its
+    /// strata. The frame's set-up (VPLs, triangle BVHs) is done here, as in a render.
+    pub fn shade_pixels(
+        &self,
+        frame: &Frame<'_>,
+        pixels: &[usize],
+    ) -> Result<Vec<PixelResult>, Error> {
+        let prepared = baseline::prepare(frame, METHOD.name, &self.points)?;
+        let t = self.student_t()?;
+        let est = self.estimators(&prepared, &t)?;
+        baseline::shade_pixels(frame, METHOD.name, &self.points, &prepared, &est, pixels)
+    }
 }
 
 impl PixelEstimator for EelcEstimator<'_> {
@@ -137,31 +170,9 @@ impl Integrator for Eelc {
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
-        let prepared = baseline::prepare(frame, METHOD.name, self.points.vpls)?;
-        let settings = self.settings(prepared.g_max);
-        let t = StudentT::new(self.alpha).map_err(|e| Error::Input(format!("--alpha: {e}")))?;
-        let estimators: Vec<Option<EelcEstimator<'_>>> = match &prepared.lights {
-            None => prepared.objects.iter().map(|_| None).collect(),
-            Some(lt) => prepared
-                .objects
-                .iter()
-                .map(|d| {
-                    d.as_ref()
-                        .map(|d| {
-                            EelcEstimator::new(lt, &d.ft, &t, settings)
-                                .map_err(|e| Error::Input(format!("eelc: {e}")))
-                        })
-                        .transpose()
-                })
-                .collect::<Result<_, _>>()?,
-        };
-        baseline::run(
-            frame,
-            METHOD.name,
-            &self.points,
-            &prepared,
-            &estimators,
-            progress,
-        )
+        let prepared = baseline::prepare(frame, METHOD.name, &self.points)?;
+        let t = self.student_t()?;
+        let est = self.estimators(&prepared, &t)?;
+        baseline::run(frame, METHOD.name, &self.points, &prepared, &est, progress)
     }
 }

@@ -371,17 +371,98 @@ pub(crate) fn object_data(
     Ok(out)
 }
 
-/// What [`ManyLight::shade_pixels`] gives one pixel.
+/// What [`ManyLight::shade_pixels`] (and the baselines' `shade_pixels`,
+/// [`Mdlc::shade_pixels`](super::mdlc::Mdlc::shade_pixels) and
+/// [`Eelc::shade_pixels`](super::eelc::Eelc::shade_pixels)) gives one pixel.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PixelResult {
     /// The pixel's subsurface value, assembled as the renderer assembles it.
     pub subsurface: Rgb,
-    /// The standard error of each channel (from ΔI of each object's estimate).
+    /// The standard error of each channel (from ΔI of each object's estimate; EELC's against
+    /// its own point set's value; 0 for MDLC, which has no interval).
     pub std_error: Rgb,
-    /// Triplets over the pixel's objects.
+    /// Triplets over the pixel's objects; for the baselines the cluster pairs (MDLC's cut
+    /// size, EELC's strata).
     pub triplets: f64,
-    /// The counters of the pixel's estimates.
+    /// The counters of the pixel's estimates (for the baselines, pairs in place of triplets
+    /// and the pair cap in place of the triplet cap).
     pub summary: Summary,
+}
+
+/// A subset pixel's result from its G-buffer samples' values, assembled exactly as the
+/// renderer assembles a full frame (shared with the baselines).
+pub(crate) fn pixel_result(
+    frame: &Frame<'_>,
+    i: usize,
+    values: &[Rgb],
+    std_error: Rgb,
+    triplets: f64,
+    summary: Summary,
+) -> PixelResult {
+    let gb = &frame.gbuffer;
+    let vals: Vec<Option<Rgb>> = gb
+        .pixel(i)
+        .iter()
+        .zip(values)
+        .map(|(g, v)| frame.shading_of(g.object).map(|_| *v))
+        .collect();
+    PixelResult {
+        subsurface: crate::render::assembled_subsurface(&vals, gb.samples_per_pixel),
+        std_error,
+        triplets,
+        summary,
+    }
+}
+
+/// The visibility of the many-light methods (shared with the baselines): a shadow ray from
+/// the irradiance point (on a flat triangle, so the ray leaves it on the lit side; the origin
+/// is moved off the surface by starting the ray at 16 × the geometry's epsilon) to the VPL,
+/// stopping as far short of it.
+pub(crate) fn shadow_test<'a>(frame: &'a Frame<'_>) -> impl Fn(DVec3, DVec3) -> bool + Sync + 'a {
+    let geom = &frame.geom;
+    let eps_ray = 16.0 * geom.epsilon();
+    move |x: DVec3, y: DVec3| {
+        let d = y - x;
+        let dist = d.length();
+        if !(dist > 2.0 * eps_ray) {
+            return false;
+        }
+        !geom.occluded(x, d / dist, eps_ray, dist - eps_ray)
+    }
+}
+
+/// The pixels to shade: `only`, in its order, or every pixel of the frame; a pixel past the
+/// image is an input error naming `method` (shared with the baselines).
+pub(crate) fn pixel_list(
+    frame: &Frame<'_>,
+    only: Option<&[usize]>,
+    method: &str,
+) -> Result<Vec<usize>, Error> {
+    let n = frame.gbuffer.pixels();
+    if let Some(&bad) = only.and_then(|p| p.iter().find(|&&i| i >= n)) {
+        return Err(Error::Input(format!(
+            "{method}: pixel {bad} is past the image's {n} pixels"
+        )));
+    }
+    Ok(only.map_or_else(|| (0..n).collect(), <[usize]>::to_vec))
+}
+
+/// `seed` with the random stream `stream` mixed in (`seed` itself for stream 0, so the default
+/// stream keeps a render's bits); shared with the baselines.
+pub(crate) fn stream_seed(seed: u64, stream: u64) -> u64 {
+    if stream == 0 {
+        seed
+    } else {
+        seed ^ sss_util::splitmix64(stream ^ 0x5354_5245_414d)
+    }
+}
+
+/// The seed of pixel `i`'s estimate on object `o` under the frame's seed and the estimator
+/// stream `stream` (shared with the baselines): a pixel's estimate depends on its own index,
+/// never on which other pixels are shaded or on the thread.
+pub(crate) fn estimate_seed(frame_seed: u64, o: u32, stream: u64, i: usize) -> u64 {
+    let object_seed = stream_seed(frame_seed ^ sss_util::splitmix64(u64::from(o)), stream);
+    pixel_seed(sss_util::splitmix64(object_seed), i as u64)
 }
 
 impl ManyLight {
@@ -425,27 +506,9 @@ impl ManyLight {
                 })
                 .collect::<Result<_, _>>()?,
         };
-        let geom = &frame.geom;
-        let eps_ray = 16.0 * geom.epsilon();
-        // Shadow rays from the irradiance point (on a flat triangle, so the ray leaves it on the
-        // lit side; the origin is moved off the surface by starting the ray at eps_ray) to the
-        // VPL, stopping short of it.
-        let visibility = |xi: DVec3, y: DVec3| {
-            let d = y - xi;
-            let dist = d.length();
-            if !(dist > 2.0 * eps_ray) {
-                return false;
-            }
-            !geom.occluded(xi, d / dist, eps_ray, dist - eps_ray)
-        };
+        let visibility = shadow_test(frame);
         let gb = &frame.gbuffer;
-        let n = gb.pixels();
-        if let Some(&bad) = only.and_then(|p| p.iter().find(|&&i| i >= n)) {
-            return Err(Error::Input(format!(
-                "manylight: pixel {bad} is past the image's {n} pixels"
-            )));
-        }
-        let list: Vec<usize> = only.map_or_else(|| (0..n).collect(), <[usize]>::to_vec);
+        let list = pixel_list(frame, only, METHOD.name)?;
         let spp = gb.samples_per_pixel as f64;
         let max_splits = settings.max_splits;
         let shade = |refs: &mut Refinements, i: usize| -> Result<PixelOut, Error> {
@@ -485,11 +548,7 @@ impl ManyLight {
                 }
                 let tree =
                     ShadingTree::new(points).map_err(|e| model_error(scene, o, METHOD.name, e))?;
-                let mut object_seed = frame.seed ^ sss_util::splitmix64(u64::from(o));
-                if self.stream != 0 {
-                    object_seed ^= sss_util::splitmix64(self.stream ^ 0x5354_5245_414d);
-                }
-                let seed = pixel_seed(sss_util::splitmix64(object_seed), i as u64);
+                let seed = estimate_seed(frame.seed, o, self.stream, i);
                 let px = est.estimate_with(&tree, &visibility, seed, refs);
                 out.summary.add(&px);
                 out.triplets += px.triplets as f64;
@@ -538,24 +597,10 @@ impl ManyLight {
     ) -> Result<Vec<PixelResult>, Error> {
         let (outs, _, _, _) =
             self.estimate_pixels(frame, Some(pixels), &crate::progress::NoProgress)?;
-        let gb = &frame.gbuffer;
         Ok(outs
             .into_iter()
             .zip(pixels)
-            .map(|(o, &i)| {
-                let vals: Vec<Option<Rgb>> = gb
-                    .pixel(i)
-                    .iter()
-                    .zip(&o.values)
-                    .map(|(g, v)| frame.shading_of(g.object).map(|_| *v))
-                    .collect();
-                PixelResult {
-                    subsurface: crate::render::assembled_subsurface(&vals, gb.samples_per_pixel),
-                    std_error: o.std_error,
-                    triplets: o.triplets,
-                    summary: o.summary,
-                }
-            })
+            .map(|(o, &i)| pixel_result(frame, i, &o.values, o.std_error, o.triplets, o.summary))
             .collect())
     }
 }

@@ -14,8 +14,9 @@
 //! textures.
 
 use super::baseline::{
-    self, IRRADIANCE_POINTS, MAX_PAIRS, PixelEstimator, PointOptions, UNIFORM_POINTS,
+    self, IRRADIANCE_POINTS, MAX_PAIRS, PixelEstimator, PointOptions, Prepared, UNIFORM_POINTS,
 };
+use super::manylight::PixelResult;
 use super::{Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Sweep};
 use crate::Error;
 use crate::frame::Frame;
@@ -92,6 +93,29 @@ impl Mdlc {
         s.max_pairs = self.points.max_pairs;
         s
     }
+
+    /// The per-object cuts of a prepared frame.
+    fn cuts<'a>(&self, prepared: &'a Prepared) -> Result<Vec<Option<MdlcCut<'a>>>, Error> {
+        let settings = self.settings(prepared.g_max);
+        baseline::estimators(prepared, METHOD.name, |lt, d| {
+            MdlcCut::new(lt, &d.ft, settings)
+        })
+    }
+
+    /// The estimates of the pixels `pixels` of `frame` only, in that order (for subset
+    /// references and error measurements): each pixel's subsurface value equals what a full
+    /// render gives it with the same seed (its points and cut depend on its own index only);
+    /// `triplets` holds its cut size and `std_error` is 0 (MDLC has no interval). The frame's
+    /// set-up (VPLs, triangle BVHs) is done here, as in a render.
+    pub fn shade_pixels(
+        &self,
+        frame: &Frame<'_>,
+        pixels: &[usize],
+    ) -> Result<Vec<PixelResult>, Error> {
+        let prepared = baseline::prepare(frame, METHOD.name, &self.points)?;
+        let cuts = self.cuts(&prepared)?;
+        baseline::shade_pixels(frame, METHOD.name, &self.points, &prepared, &cuts, pixels)
+    }
 }
 
 impl PixelEstimator for MdlcCut<'_> {
@@ -130,30 +154,8 @@ impl Integrator for Mdlc {
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
-        let prepared = baseline::prepare(frame, METHOD.name, self.points.vpls)?;
-        let settings = self.settings(prepared.g_max);
-        let estimators: Vec<Option<MdlcCut<'_>>> = match &prepared.lights {
-            None => prepared.objects.iter().map(|_| None).collect(),
-            Some(lt) => prepared
-                .objects
-                .iter()
-                .map(|d| {
-                    d.as_ref()
-                        .map(|d| {
-                            MdlcCut::new(lt, &d.ft, settings)
-                                .map_err(|e| Error::Input(format!("mdlc: {e}")))
-                        })
-                        .transpose()
-                })
-                .collect::<Result<_, _>>()?,
-        };
-        baseline::run(
-            frame,
-            METHOD.name,
-            &self.points,
-            &prepared,
-            &estimators,
-            progress,
-        )
+        let prepared = baseline::prepare(frame, METHOD.name, &self.points)?;
+        let cuts = self.cuts(&prepared)?;
+        baseline::run(frame, METHOD.name, &self.points, &prepared, &cuts, progress)
     }
 }

@@ -11,6 +11,17 @@
 //! 3. **VPL count** (Fig. 9): time and triplets at ×½ … ×8 the VPLs, and **mesh refinement**:
 //!    the same at 4× and 16× the triangles (midpoint subdivision).
 //! 4. **Pictures** (Fig. 7): the Buddha, and its triplets per pixel with each selection.
+//! 5. **Against the baselines** (Table 1, Fig. 6): MDLC and EELC on the same VPLs, subset and
+//!    reference, each with BSSRDF importance-sampled irradiance points (probe rays, "IS") and
+//!    with uniform ones, over a sweep of the points per shading point N at ε = 2 %
+//!    ([`Plan::points_is`], [`Plan::points_uniform`]): RMSE against time per scene, and
+//!    Table 1's equal quality (the time each needs to reach ours' RMSE at ε = 2 %, log-log
+//!    interpolated along its sweep, [`equal::time_to_reach`]) and equal time (its RMSE at ours'
+//!    time, [`equal::error_at_time`]); and EELC's estimation accuracy at the ε of item 1 with
+//!    [`Plan::eelc_points`] points (Fig. 10). With N points per shading point the baselines
+//!    converge, as ε → 0, to their point set's value, whose error is the N-point Monte Carlo
+//!    noise (∝ N^−½): N bounds the error they can reach at any ε; at a fixed ε their own
+//!    estimate's error (EELC's about ours' at the same ε) bounds it at any N.
 //!
 //! **The reference.** The paper renders its reference with the method at ε = 0.1 %; on 2 cores
 //! that is out of reach (≈ 400× the triplets of ε = 2 %). Instead each subset pixel is
@@ -29,17 +40,27 @@
 //! the jittered VPL grid move with the seed), and the measured "accuracy" falls to 50–70 %
 //! whatever the estimator does.
 //!
-//! Writes `manylight.csv`, `manylight_accuracy.png`, `manylight_vpls.png` and
-//! `manylight/*.png` under the output directory.
+//! Every run is timed with its frame set-up (G-buffer, VPLs, triangle BVHs) included.
+//!
+//! Writes `manylight.csv` (one row per run, column `method`: `manylight`, `mdlc-is`,
+//! `mdlc-uniform`, `eelc-is`, `eelc-uniform`), `manylight_accuracy.png`,
+//! `manylight_vpls.png`, `manylight_rmse_<scene>.png` and `manylight/*.png` under the output
+//! directory.
+
+mod equal;
 
 use super::output::{csv_num, md_num, md_table, write_atomic};
 use super::{Context, Error, Experiment, Section};
+use equal::{Reach, error_at_time, extrapolated_time, time_to_reach};
 use sss_bssrdf::Rgb;
 use sss_manylight::Selection;
-use sss_plot::{Series, SeriesStyle, line_plot, write_error_map};
+use sss_plot::{PALETTE, Series, SeriesStyle, line_plot, write_error_map};
 use sss_render::frame::Frame;
+use sss_render::integrators::baseline::PointOptions;
+use sss_render::integrators::eelc::Eelc;
 use sss_render::integrators::exact::translucent_pixels;
 use sss_render::integrators::manylight::{ManyLight, PixelResult};
+use sss_render::integrators::mdlc::Mdlc;
 use sss_render::metrics::subset_pixels;
 use sss_render::progress::NoProgress;
 use sss_render::render::{RenderSettings, render};
@@ -210,6 +231,12 @@ struct Plan {
     vpl_factors: Vec<f64>,
     /// Subdivision levels of the mesh experiment (each ×4 triangles).
     subdivisions: Vec<u32>,
+    /// Irradiance points per shading point of the baselines' importance-sampled sweeps.
+    points_is: Vec<u32>,
+    /// Irradiance points per shading point of the baselines' uniform sweeps.
+    points_uniform: Vec<u32>,
+    /// Irradiance points per shading point of EELC's accuracy sweep (importance-sampled).
+    eelc_points: u32,
 }
 
 fn plan(quick: bool) -> Plan {
@@ -226,6 +253,9 @@ fn plan(quick: bool) -> Plan {
             picture_eps: 0.05,
             vpl_factors: vec![0.5, 1.0, 2.0],
             subdivisions: vec![0, 1],
+            points_is: vec![16, 64],
+            points_uniform: vec![64],
+            eelc_points: 64,
         }
     } else {
         Plan {
@@ -244,6 +274,97 @@ fn plan(quick: bool) -> Plan {
             picture_eps: 0.05,
             vpl_factors: vec![0.5, 1.0, 2.0, 4.0, 8.0],
             subdivisions: vec![0, 1, 2],
+            points_is: vec![64, 256, 1024, 4096],
+            points_uniform: vec![256, 1024, 4096],
+            eelc_points: 1024,
+        }
+    }
+}
+
+/// A method of the comparison, with its settings.
+#[derive(Clone, Copy, Debug)]
+enum Method {
+    /// Nabata & Iwasaki's.
+    Ours(ManyLight),
+    /// Multidimensional Lightcuts over fixed points.
+    Mdlc(Mdlc),
+    /// The error estimation for Lightcuts over fixed points.
+    Eelc(Eelc),
+}
+
+/// The name of `manylight` in the CSV's `method` column.
+const OURS: &str = "manylight";
+
+impl Method {
+    /// The `method` column: `manylight`, or the baseline and its points (`mdlc-is`,
+    /// `eelc-uniform`, …).
+    fn label(&self) -> &'static str {
+        match self {
+            Method::Ours(_) => OURS,
+            Method::Mdlc(m) if m.points.uniform => "mdlc-uniform",
+            Method::Mdlc(_) => "mdlc-is",
+            Method::Eelc(m) if m.points.uniform => "eelc-uniform",
+            Method::Eelc(_) => "eelc-is",
+        }
+    }
+
+    fn eps(&self) -> f64 {
+        match self {
+            Method::Ours(m) => m.eps,
+            Method::Mdlc(m) => m.eps,
+            Method::Eelc(m) => m.eps,
+        }
+    }
+
+    /// Irradiance points per shading point (0 for ours, which has none fixed).
+    fn points(&self) -> u32 {
+        match self {
+            Method::Ours(_) => 0,
+            Method::Mdlc(m) => m.points.irradiance_points,
+            Method::Eelc(m) => m.points.irradiance_points,
+        }
+    }
+
+    fn vpls(&self) -> u32 {
+        match self {
+            Method::Ours(m) => m.vpls,
+            Method::Mdlc(m) => m.points.vpls,
+            Method::Eelc(m) => m.points.vpls,
+        }
+    }
+
+    /// The `selection` column (`-` for the baselines, which select by their own rules).
+    fn selection(&self) -> &'static str {
+        match self {
+            Method::Ours(m) => selection_name(m.selection),
+            _ => "-",
+        }
+    }
+
+    /// The same method on estimator stream `stream` (new points for the baselines).
+    fn with_stream(self, stream: u64) -> Method {
+        match self {
+            Method::Ours(m) => Method::Ours(ManyLight { stream, ..m }),
+            Method::Mdlc(m) => Method::Mdlc(Mdlc {
+                points: PointOptions { stream, ..m.points },
+                ..m
+            }),
+            Method::Eelc(m) => Method::Eelc(Eelc {
+                points: PointOptions { stream, ..m.points },
+                ..m
+            }),
+        }
+    }
+
+    fn shade_pixels(
+        &self,
+        frame: &Frame<'_>,
+        pixels: &[usize],
+    ) -> Result<Vec<PixelResult>, sss_render::Error> {
+        match self {
+            Method::Ours(m) => m.shade_pixels(frame, pixels),
+            Method::Mdlc(m) => m.shade_pixels(frame, pixels),
+            Method::Eelc(m) => m.shade_pixels(frame, pixels),
         }
     }
 }
@@ -253,8 +374,12 @@ fn plan(quick: bool) -> Plan {
 struct Row {
     scene: &'static str,
     experiment: &'static str,
+    /// [`Method::label`].
+    method: &'static str,
     selection: &'static str,
     eps: f64,
+    /// Irradiance points per shading point (0 for ours).
+    points: u32,
     vpls: u32,
     triangles: usize,
     seed: u64,
@@ -265,6 +390,8 @@ struct Row {
     accuracy: f64,
     /// RMSE over the subset (pixels and channels).
     rmse: f64,
+    /// Relative bias of the summed luminance ([`bias`]).
+    bias: f64,
     /// Pixels that stopped at a cap.
     capped: u64,
 }
@@ -360,22 +487,48 @@ fn base(ctx: &Context<'_>, vpls: u32) -> ManyLight {
     }
 }
 
+/// The baselines' points: `n` per shading point, importance-sampled or uniform, with the
+/// VPLs of [`base`] (the run's seed, [`VPLS`]).
+fn points(ctx: &Context<'_>, n: u32, uniform: bool) -> PointOptions {
+    PointOptions {
+        irradiance_points: n,
+        uniform,
+        vpls: VPLS,
+        vpl_seed: Some(ctx.config.seed),
+        ..PointOptions::default()
+    }
+}
+
+/// MDLC at `eps` over `points`.
+fn mdlc(eps: f64, points: PointOptions) -> Method {
+    Method::Mdlc(Mdlc { eps, points })
+}
+
+/// EELC at `eps` (α = 95 %) over `points`.
+fn eelc(eps: f64, points: PointOptions) -> Method {
+    Method::Eelc(Eelc {
+        eps,
+        points,
+        ..Eelc::default()
+    })
+}
+
 /// Runs `m` on the subset `pixels` of `scene` with estimator stream `stream`, timed (frame
 /// set-up included). The G-buffer is always the run's seed's: every run estimates the same
 /// pixel values (the camera samples depend on the frame's seed).
 fn shade(
     ctx: &Context<'_>,
     scene: &Scene,
-    m: &ManyLight,
+    m: &Method,
     pixels: &[usize],
     stream: u64,
 ) -> Result<(Vec<PixelResult>, f64), Error> {
     let t0 = Instant::now();
     let frame = Frame::prepare(scene, ctx.config.seed);
-    let m = ManyLight { stream, ..*m };
     let out = m
+        .with_stream(stream)
         .shade_pixels(&frame, pixels)
-        .map_err(|e| Error(format!("scene {}: manylight: {e}", scene.name)))?;
+        .map_err(|e| Error(format!("scene {}: {}: {e}", scene.name, m.label())))?;
     Ok((out, t0.elapsed().as_secs_f64()))
 }
 
@@ -398,7 +551,7 @@ fn reference(ctx: &Context<'_>, scene: &Scene, p: &Plan) -> Result<Reference, Er
         p.ref_triplets
     ));
     // A seed of its own: the reference's samples are independent of every run it scores.
-    let (out, seconds) = shade(ctx, scene, &m, &pixels, 0x5245_4600)?;
+    let (out, seconds) = shade(ctx, scene, &Method::Ours(m), &pixels, 0x5245_4600)?;
     let values: Vec<Rgb> = out.iter().map(|r| r.subsurface).collect();
     let rel_se = out
         .iter()
@@ -434,6 +587,19 @@ fn score(out: &[PixelResult], r: &Reference, eps: f64) -> (f64, f64, usize) {
     (if n > 0 { ok as f64 / n as f64 } else { 0.0 }, rmse, n)
 }
 
+/// The relative bias of the luminance over the subset, Σ (Î − I) / Σ I (0 when the
+/// reference is black): a method that estimates another integral shows here, where RMSE
+/// cannot tell bias from noise.
+fn bias(out: &[PixelResult], r: &Reference) -> f64 {
+    let (d, t) = out
+        .iter()
+        .zip(&r.values)
+        .fold((0.0, 0.0), |(d, t), (o, v)| {
+            (d + lum(o.subsurface) - lum(*v), t + lum(*v))
+        });
+    if t > 0.0 { d / t } else { 0.0 }
+}
+
 /// The manylight experiment.
 pub struct ManyLightExperiment;
 
@@ -458,27 +624,32 @@ impl Experiment for ManyLightExperiment {
             };
             let r = reference(ctx, &scene, &p)?;
             let tri = triangles(&scene);
-            let run = |m: &ManyLight,
+            let run = |m: &Method,
                        sc: &Scene,
                        experiment: &'static str,
                        seed: u64,
                        rows: &mut Vec<Row>|
              -> Result<(), Error> {
                 (ctx.log)(&format!(
-                    "manylight: {name} {experiment} ε={} {} VPLs {} seed {seed}",
-                    m.eps,
-                    m.vpls,
-                    selection_name(m.selection)
+                    "manylight: {name} {experiment} {} ε={} N={} {} VPLs {} seed {seed}",
+                    m.label(),
+                    m.eps(),
+                    m.points(),
+                    m.vpls(),
+                    m.selection()
                 ));
                 let (out, seconds) = shade(ctx, sc, m, &r.pixels, seed)?;
-                let (accuracy, rmse, pixels) = score(&out, &r, m.eps);
+                let (accuracy, rmse, pixels) = score(&out, &r, m.eps());
+                let bias = bias(&out, &r);
                 let n = out.len().max(1) as f64;
                 rows.push(Row {
                     scene: name,
                     experiment,
-                    selection: selection_name(m.selection),
-                    eps: m.eps,
-                    vpls: m.vpls,
+                    method: m.label(),
+                    selection: m.selection(),
+                    eps: m.eps(),
+                    points: m.points(),
+                    vpls: m.vpls(),
                     triangles: triangles(sc),
                     seed,
                     seconds,
@@ -486,6 +657,7 @@ impl Experiment for ManyLightExperiment {
                     mean_triplets: out.iter().map(|o| o.triplets).sum::<f64>() / n,
                     accuracy,
                     rmse,
+                    bias,
                     capped: out
                         .iter()
                         .map(|o| o.summary.triplet_cap + o.summary.split_cap)
@@ -493,9 +665,11 @@ impl Experiment for ManyLightExperiment {
                 });
                 Ok(())
             };
-            let ours = |eps: f64| ManyLight {
-                eps,
-                ..base(ctx, VPLS)
+            let ours = |eps: f64| {
+                Method::Ours(ManyLight {
+                    eps,
+                    ..base(ctx, VPLS)
+                })
             };
             // 1. Accuracy against ε.
             for &eps in &p.eps {
@@ -504,10 +678,11 @@ impl Experiment for ManyLightExperiment {
                 }
             }
             // 2. Max-Extent at the fixed ε (BSSRDF-aware's rows are the sweep's at that ε).
-            let max_extent = ManyLight {
+            let max_extent = Method::Ours(ManyLight {
                 selection: Selection::MaxExtent,
-                ..ours(p.fixed_eps)
-            };
+                eps: p.fixed_eps,
+                ..base(ctx, VPLS)
+            });
             run(&max_extent, &scene, "selection", cfg.seed + 1, &mut rows)?;
             if !p.eps.contains(&p.fixed_eps) {
                 run(
@@ -521,10 +696,10 @@ impl Experiment for ManyLightExperiment {
             // 3. VPLs and mesh refinement, on the first scene only.
             if refs.is_empty() {
                 for &f in &p.vpl_factors {
-                    let m = ManyLight {
+                    let m = Method::Ours(ManyLight {
                         eps: p.fixed_eps,
                         ..base(ctx, ((VPLS as f64 * f).round() as u32).max(1))
-                    };
+                    });
                     run(&m, &scene, "vpls", cfg.seed + 1, &mut rows)?;
                 }
                 for &l in &p.subdivisions {
@@ -532,6 +707,51 @@ impl Experiment for ManyLightExperiment {
                     run(&ours(p.fixed_eps), &fine, "mesh", cfg.seed + 1, &mut rows)?;
                 }
                 pictures(ctx, &scene, &p, &dir)?;
+            }
+            // 5. The baselines: RMSE against time over N at the fixed ε (Table 1, Fig. 6),
+            // importance-sampled and uniform points; one stream each (their cost is the
+            // points, and their error the points' noise).
+            let stream = cfg.seed + 1;
+            for (uniform, ns) in [(false, &p.points_is), (true, &p.points_uniform)] {
+                for &n in ns {
+                    let pts = points(ctx, n, uniform);
+                    run(
+                        &mdlc(p.fixed_eps, pts),
+                        &scene,
+                        "quality",
+                        stream,
+                        &mut rows,
+                    )?;
+                    run(
+                        &eelc(p.fixed_eps, pts),
+                        &scene,
+                        "quality",
+                        stream,
+                        &mut rows,
+                    )?;
+                }
+            }
+            // EELC's estimation accuracy against ε (Fig. 10) at a fixed N: the run at the fixed
+            // ε is the quality sweep's when that has the same N (same stream, same points).
+            let pts = points(ctx, p.eelc_points, false);
+            for &eps in &p.eps {
+                let same = rows.iter().rposition(|x| {
+                    x.scene == name
+                        && x.experiment == "quality"
+                        && x.method == "eelc-is"
+                        && x.points == p.eelc_points
+                        && x.eps == eps
+                });
+                match same {
+                    Some(k) => {
+                        let row = Row {
+                            experiment: "accuracy",
+                            ..rows[k].clone()
+                        };
+                        rows.push(row);
+                    }
+                    None => run(&eelc(eps, pts), &scene, "accuracy", stream, &mut rows)?,
+                }
             }
             refs.push((name, r, tri));
         }
@@ -625,17 +845,19 @@ fn pictures(
 
 fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
-        "scene,experiment,selection,eps,vpls,triangles,seed,seconds,pixels,mean_triplets,\
-         accuracy,rmse,capped\n",
+        "scene,experiment,method,selection,eps,points,vpls,triangles,seed,seconds,pixels,\
+         mean_triplets,accuracy,rmse,bias,capped\n",
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.scene,
             r.experiment,
+            r.method,
             r.selection,
             r.eps,
+            r.points,
             r.vpls,
             r.triangles,
             r.seed,
@@ -644,6 +866,7 @@ fn csv(rows: &[Row]) -> String {
             csv_num(Some(r.mean_triplets)),
             csv_num(Some(r.accuracy)),
             csv_num(Some(r.rmse)),
+            csv_num(Some(r.bias)),
             r.capped
         );
     }
@@ -661,30 +884,79 @@ fn pooled(rows: &[&Row]) -> (f64, f64, usize) {
     (a, (a * (1.0 - a) / n as f64).sqrt(), n)
 }
 
+/// The accuracy rows of `method` on `scene` at `eps` (every stream).
+fn accuracy_rows<'a>(rows: &'a [Row], scene: &str, method: &str, eps: f64) -> Vec<&'a Row> {
+    rows.iter()
+        .filter(|r| {
+            r.scene == scene && r.experiment == "accuracy" && r.method == method && r.eps == eps
+        })
+        .collect()
+}
+
+/// Ours' sweep on `scene`: per ε of the plan (loosest first) the mean seconds and RMSE over
+/// the streams, with that ε.
+fn ours_sweep(rows: &[Row], scene: &str, p: &Plan) -> Vec<(f64, f64, f64)> {
+    p.eps
+        .iter()
+        .filter_map(|&eps| {
+            let rs = accuracy_rows(rows, scene, OURS, eps);
+            let n = rs.len() as f64;
+            (!rs.is_empty()).then(|| {
+                (
+                    eps,
+                    rs.iter().map(|x| x.seconds).sum::<f64>() / n,
+                    rs.iter().map(|x| x.rmse).sum::<f64>() / n,
+                )
+            })
+        })
+        .collect()
+}
+
+/// A baseline's quality sweep on `scene`: (N, seconds, RMSE), fewest points first.
+fn baseline_sweep(rows: &[Row], scene: &str, method: &str) -> Vec<(u32, f64, f64)> {
+    let mut v: Vec<(u32, f64, f64)> = rows
+        .iter()
+        .filter(|r| r.scene == scene && r.experiment == "quality" && r.method == method)
+        .map(|r| (r.points, r.seconds, r.rmse))
+        .collect();
+    v.sort_by_key(|x| x.0);
+    v
+}
+
+/// The baselines of Table 1, in its column order.
+const BASELINES: [&str; 4] = ["eelc-is", "mdlc-is", "eelc-uniform", "mdlc-uniform"];
+
 fn plots(ctx: &Context<'_>, rows: &[Row], p: &Plan) -> Result<(), Error> {
     let out = &ctx.config.out;
     let scenes: Vec<&str> = p.scenes.iter().map(|s| s.0).collect();
     let mut acc = Vec::new();
-    for name in &scenes {
-        let pts: Vec<(f64, f64)> = p
-            .eps
-            .iter()
-            .filter_map(|&eps| {
-                let rs: Vec<&Row> = rows
-                    .iter()
-                    .filter(|r| r.scene == *name && r.experiment == "accuracy" && r.eps == eps)
-                    .collect();
-                (!rs.is_empty()).then(|| (100.0 * eps, 100.0 * pooled(&rs).0))
-            })
-            .collect();
-        if !pts.is_empty() {
-            acc.push(Series {
-                name: (*name).into(),
-                points: pts,
-                color: None,
-                style: SeriesStyle::LineMarkers,
-                ..Series::default()
-            });
+    for (k, name) in scenes.iter().enumerate() {
+        let color = PALETTE[k % PALETTE.len()];
+        for (method, label, style) in [
+            (OURS, "ours".to_string(), SeriesStyle::LineMarkers),
+            (
+                "eelc-is",
+                format!("EELC N = {}", p.eelc_points),
+                SeriesStyle::Dashed,
+            ),
+        ] {
+            let pts: Vec<(f64, f64)> = p
+                .eps
+                .iter()
+                .filter_map(|&eps| {
+                    let rs = accuracy_rows(rows, name, method, eps);
+                    (!rs.is_empty()).then(|| (100.0 * eps, 100.0 * pooled(&rs).0))
+                })
+                .collect();
+            if !pts.is_empty() {
+                acc.push(Series {
+                    name: format!("{name}, {label}"),
+                    points: pts,
+                    color: Some(color),
+                    style,
+                    ..Series::default()
+                });
+            }
         }
     }
     if !acc.is_empty() {
@@ -708,6 +980,65 @@ fn plots(ctx: &Context<'_>, rows: &[Row], p: &Plan) -> Result<(), Error> {
             false,
         )
         .map_err(|e| Error(format!("manylight_accuracy.png: {e}")))?;
+    }
+    // RMSE against time per scene (Fig. 6).
+    for name in &scenes {
+        let mut series = Vec::new();
+        let ours: Vec<(f64, f64)> = ours_sweep(rows, name, p)
+            .iter()
+            .map(|&(_, t, e)| (t, e))
+            .collect();
+        if ours.is_empty() {
+            continue;
+        }
+        series.push(Series {
+            name: "ours (ε sweep)".into(),
+            points: ours,
+            color: Some(PALETTE[0]),
+            style: SeriesStyle::LineMarkers,
+            ..Series::default()
+        });
+        for (k, method) in BASELINES.iter().enumerate() {
+            let pts: Vec<(f64, f64)> = baseline_sweep(rows, name, method)
+                .iter()
+                .map(|&(_, t, e)| (t, e))
+                .collect();
+            if !pts.is_empty() {
+                series.push(Series {
+                    name: format!("{method} (N sweep, ε = {} %)", 100.0 * p.fixed_eps),
+                    points: pts,
+                    color: Some(PALETTE[(k + 1) % PALETTE.len()]),
+                    style: SeriesStyle::LineMarkers,
+                    ..Series::default()
+                });
+            }
+        }
+        let eelc_eps: Vec<(f64, f64)> = p
+            .eps
+            .iter()
+            .flat_map(|&eps| accuracy_rows(rows, name, "eelc-is", eps))
+            .map(|r| (r.seconds, r.rmse))
+            .collect();
+        if !eelc_eps.is_empty() {
+            series.push(Series {
+                name: format!("eelc-is (ε sweep, N = {})", p.eelc_points),
+                points: eelc_eps,
+                color: Some(PALETTE[5 % PALETTE.len()]),
+                style: SeriesStyle::Markers,
+                ..Series::default()
+            });
+        }
+        let file = format!("manylight_rmse_{name}.png");
+        line_plot(
+            &out.join(&file),
+            &format!("{name}: RMSE against time on the subset (frame set-up included)"),
+            "seconds",
+            "RMSE",
+            &series,
+            true,
+            true,
+        )
+        .map_err(|e| Error(format!("{file}: {e}")))?;
     }
     let vp: Vec<(f64, f64)> = rows
         .iter()
@@ -733,6 +1064,187 @@ fn plots(ctx: &Context<'_>, rows: &[Row], p: &Plan) -> Result<(), Error> {
         .map_err(|e| Error(format!("manylight_vpls.png: {e}")))?;
     }
     Ok(())
+}
+
+/// Ours at the fixed ε on `scene`: (seconds, RMSE), means over the streams.
+fn ours_at_fixed(rows: &[Row], scene: &str, p: &Plan) -> Option<(f64, f64)> {
+    ours_sweep(rows, scene, p)
+        .into_iter()
+        .find(|x| x.0 == p.fixed_eps)
+        .map(|x| (x.1, x.2))
+}
+
+/// `method`'s equal quality on `scene` against the RMSE `target`: where its sweep reaches it,
+/// and, when it does not, the time its slowest run extrapolates to.
+fn equal_quality(
+    rows: &[Row],
+    scene: &str,
+    method: &str,
+    target: f64,
+) -> (Option<Reach>, Option<f64>) {
+    let sweep = baseline_sweep(rows, scene, method);
+    let curve: Vec<(f64, f64)> = sweep.iter().map(|x| (x.1, x.2)).collect();
+    let reach = time_to_reach(&curve, target);
+    let extrapolated = match reach {
+        Some(Reach::NotReached(_)) => sweep
+            .last()
+            .and_then(|l| extrapolated_time((l.1, l.2), target)),
+        _ => None,
+    };
+    (reach, extrapolated)
+}
+
+/// The equal-quality time and ours' speed-up (baseline time over ours') as table cells.
+fn reach_cells(reach: Option<Reach>, extrapolated: Option<f64>, t_ours: f64) -> [String; 2] {
+    let x = |t: f64| md_num(Some(t / t_ours), 3);
+    match reach {
+        None => ["–".into(), "–".into()],
+        Some(Reach::At(t)) => [md_num(Some(t), 3), format!("{}×", x(t))],
+        Some(Reach::AtMost(t)) => [
+            format!("≤ {} (its cheapest run)", md_num(Some(t), 3)),
+            format!("≤ {}×", x(t)),
+        ],
+        Some(Reach::NotReached(t)) => match extrapolated {
+            Some(e) => [
+                format!(
+                    "not reached (> {}; ≈ {} extrapolated)",
+                    md_num(Some(t), 3),
+                    md_num(Some(e), 3)
+                ),
+                format!("> {}× (≈ {}×)", x(t), x(e)),
+            ],
+            None => [
+                format!("not reached (> {})", md_num(Some(t), 3)),
+                format!("> {}×", x(t)),
+            ],
+        },
+    }
+}
+
+/// Table 1: per scene and baseline, equal quality and equal time against ours at the fixed ε.
+fn table1(rows: &[Row], refs: &[(&'static str, Reference, usize)], p: &Plan) -> String {
+    let mut out = String::new();
+    let mut t_rows = Vec::new();
+    for (name, _, _) in refs {
+        let Some((t_ours, e_ours)) = ours_at_fixed(rows, name, p) else {
+            continue;
+        };
+        for method in BASELINES {
+            let sweep = baseline_sweep(rows, name, method);
+            if sweep.is_empty() {
+                continue;
+            }
+            let curve: Vec<(f64, f64)> = sweep.iter().map(|x| (x.1, x.2)).collect();
+            let (reach, extrapolated) = equal_quality(rows, name, method, e_ours);
+            let [tq, speed] = reach_cells(reach, extrapolated, t_ours);
+            let equal_time = match error_at_time(&curve, t_ours) {
+                Some(e) => format!(
+                    "{} ({}× ours)",
+                    md_num(Some(e), 3),
+                    md_num(Some(e / e_ours), 3)
+                ),
+                None => {
+                    let lo = curve.iter().map(|c| c.0).fold(f64::INFINITY, f64::min);
+                    let hi = curve.iter().map(|c| c.0).fold(0.0, f64::max);
+                    format!(
+                        "outside its runs ({}–{} s)",
+                        md_num(Some(lo), 3),
+                        md_num(Some(hi), 3)
+                    )
+                }
+            };
+            let runs: Vec<String> = sweep
+                .iter()
+                .map(|(n, t, e)| format!("{n}: {} s, {}", md_num(Some(*t), 3), md_num(Some(*e), 3)))
+                .collect();
+            t_rows.push(vec![
+                (*name).to_string(),
+                format!("{} s, {}", md_num(Some(t_ours), 3), md_num(Some(e_ours), 3)),
+                method.to_string(),
+                runs.join("; "),
+                tq,
+                speed,
+                equal_time,
+            ]);
+        }
+    }
+    if t_rows.is_empty() {
+        return out;
+    }
+    let _ = writeln!(
+        out,
+        "\n**Against MDLC and EELC** (Table 1, Fig. 6). Ours at ε = {e} % (mean over the \
+         streams) against each baseline at ε = {e} % over N irradiance points per shading point \
+         (importance-sampled: {is:?}; uniform: {un:?}; one stream each), all on the same subset, \
+         VPLs and reference, every time with its frame set-up. Equal quality: the time the \
+         baseline needs to reach ours' RMSE, log-log interpolated along its N sweep at its \
+         first crossing (\"not reached\": no run gets there, and ours' speed-up is at least \
+         the slowest run's time over ours'; the extrapolation assumes RMSE ∝ N^−½ and time ∝ N \
+         from its largest N, optimistic for the baseline where its curve flattens); the \
+         speed-up is that time over ours'. Equal time: the baseline's RMSE at ours' time, \
+         log-log interpolated between its runs. A baseline's error has two parts: its N points' \
+         Monte Carlo noise (∝ N^−½ whatever ε: N bounds the error it can reach at any ε), and \
+         its estimate of its point set's value at ε (EELC's about as large as ours at the same \
+         ε, MDLC's biased representatives: ε bounds the error at any N); see EELC's ε sweep \
+         at fixed N in the plots.\n",
+        e = 100.0 * p.fixed_eps,
+        is = p.points_is,
+        un = p.points_uniform
+    );
+    out.push_str(&md_table(
+        &[
+            "scene",
+            "ours: seconds, RMSE",
+            "baseline",
+            "runs (N: seconds, RMSE)",
+            "equal quality: seconds",
+            "ours' speed-up",
+            "equal time: RMSE",
+        ],
+        &t_rows,
+    ));
+    let _ = writeln!(out, "\n{}", goal_line(rows, refs, p));
+    let pics: Vec<String> = refs
+        .iter()
+        .map(|(name, _, _)| format!("![{name}: RMSE against time](manylight_rmse_{name}.png)"))
+        .collect();
+    let _ = writeln!(out, "\n{}", pics.join(" "));
+    out
+}
+
+/// The issue's goal: at equal quality at least 5× faster than EELC with importance sampling
+/// (the paper: 1.3–12.4×), with the measured figure per scene.
+fn goal_line(rows: &[Row], refs: &[(&'static str, Reference, usize)], p: &Plan) -> String {
+    let parts: Vec<String> = refs
+        .iter()
+        .filter_map(|(name, _, _)| {
+            let (t_ours, e_ours) = ours_at_fixed(rows, name, p)?;
+            let (reach, extrapolated) = equal_quality(rows, name, "eelc-is", e_ours);
+            let [_, speed] = reach_cells(reach, extrapolated, t_ours);
+            let verdict = match reach? {
+                Reach::At(t) if t / t_ours >= 5.0 => "met",
+                Reach::At(_) => "not met",
+                Reach::AtMost(t) if t / t_ours < 5.0 => "not met",
+                Reach::AtMost(_) => "undetermined",
+                Reach::NotReached(t) if t / t_ours >= 5.0 => "met",
+                Reach::NotReached(_) => match extrapolated {
+                    Some(e) if e / t_ours >= 5.0 => "met by extrapolation",
+                    Some(_) => "not met by extrapolation",
+                    None => "undetermined",
+                },
+            };
+            Some(format!("{name} {speed} ({verdict})"))
+        })
+        .collect();
+    if parts.is_empty() {
+        return String::new();
+    }
+    format!(
+        "Goal: at equal quality (ours' RMSE at ε = {} %) at least 5× faster than EELC with \
+         importance sampling (the paper: 1.3–12.4×). Measured: {}.",
+        100.0 * p.fixed_eps,
+        parts.join("; ")
+    )
 }
 
 fn report(
@@ -794,19 +1306,32 @@ fn report(
         se.sort_by(f64::total_cmp);
         let med = se.get(se.len() / 2).copied().unwrap_or(0.0);
         for &eps in &p.eps {
-            let rs: Vec<&Row> = rows
-                .iter()
-                .filter(|x| x.scene == *name && x.experiment == "accuracy" && x.eps == eps)
-                .collect();
+            let rs = accuracy_rows(rows, name, OURS, eps);
             if rs.is_empty() {
                 continue;
             }
             let (a, a_se, n) = pooled(&rs);
+            let ee = accuracy_rows(rows, name, "eelc-is", eps);
+            let (ea, ea_se, _) = pooled(&ee);
+            let e_n = ee.len().max(1) as f64;
+            let eelc_cells = if ee.is_empty() {
+                ["–".to_string(), "–".to_string(), "–".to_string()]
+            } else {
+                [
+                    format!(
+                        "{} ± {} %",
+                        md_num(Some(100.0 * ea), 3),
+                        md_num(Some(100.0 * ea_se), 2)
+                    ),
+                    md_num(Some(ee.iter().map(|x| x.seconds).sum::<f64>() / e_n), 3),
+                    md_num(Some(ee.iter().map(|x| x.rmse).sum::<f64>() / e_n), 3),
+                ]
+            };
             let secs = rs.iter().map(|x| x.seconds).sum::<f64>() / rs.len() as f64;
             let trip = rs.iter().map(|x| x.mean_triplets).sum::<f64>() / rs.len() as f64;
             let rmse = rs.iter().map(|x| x.rmse).sum::<f64>() / rs.len() as f64;
             let capped: u64 = rs.iter().map(|x| x.capped).sum();
-            acc_rows.push(vec![
+            let mut row = vec![
                 (*name).to_string(),
                 format!("{} %", 100.0 * eps),
                 format!(
@@ -820,10 +1345,18 @@ fn report(
                 md_num(Some(rmse), 3),
                 capped.to_string(),
                 format!("{} %", md_num(Some(100.0 * med / eps), 2)),
-            ]);
+            ];
+            row.extend(eelc_cells);
+            acc_rows.push(row);
         }
     }
-    body.push_str("\n**Estimation accuracy** (Table 1, Fig. 10: the fraction of pixel estimates whose relative error is below ε, α = 95 %; ± the binomial standard error)\n\n");
+    let _ = writeln!(
+        body,
+        "\n**Estimation accuracy** (Table 1, Fig. 10: the fraction of pixel estimates whose \
+         relative error is below ε, α = 95 %; ± the binomial standard error), ours and EELC \
+         with {} importance-sampled irradiance points per shading point (one stream)\n",
+        p.eelc_points
+    );
     body.push_str(&md_table(
         &[
             "scene",
@@ -835,13 +1368,21 @@ fn report(
             "RMSE",
             "capped",
             "ref. SE / ε",
+            "EELC accuracy",
+            "EELC seconds",
+            "EELC RMSE",
         ],
         &acc_rows,
     ));
     body.push_str(
-        "\nThe last column is the reference's median relative standard error over ε: where it is \
-         not small, the reference's own noise lowers the measured accuracy.\n",
+        "\nThe column ref. SE / ε is the reference's median relative standard error over ε: \
+         where it is not small, the reference's own noise lowers the measured accuracy. EELC's \
+         interval covers the error against its own point set's value only; the point set's \
+         noise (fixed by N) is not in it, so its accuracy falls as ε nears that noise and its \
+         RMSE stops falling.\n",
     );
+    // Table 1: ours against the baselines.
+    body.push_str(&table1(rows, refs, p));
     // 2. Selection.
     let mut sel_rows = Vec::new();
     for (name, _, _) in refs {
@@ -931,7 +1472,7 @@ fn report(
     for &eps in &p.eps {
         let rs: Vec<&Row> = rows
             .iter()
-            .filter(|x| x.experiment == "accuracy" && x.eps == eps)
+            .filter(|x| x.experiment == "accuracy" && x.method == OURS && x.eps == eps)
             .collect();
         if !rs.is_empty() {
             let (a, a_se, _) = pooled(&rs);
@@ -949,6 +1490,32 @@ fn report(
         refs.len(),
         parts.join("; ")
     );
+    let eelc_parts: Vec<String> = p
+        .eps
+        .iter()
+        .filter_map(|&eps| {
+            let rs: Vec<&Row> = rows
+                .iter()
+                .filter(|x| x.experiment == "accuracy" && x.method == "eelc-is" && x.eps == eps)
+                .collect();
+            (!rs.is_empty()).then(|| {
+                format!(
+                    "{} % at ε = {} %",
+                    md_num(Some(100.0 * pooled(&rs).0), 3),
+                    100.0 * eps
+                )
+            })
+        })
+        .collect();
+    if !eelc_parts.is_empty() {
+        let _ = writeln!(
+            summary,
+            "\nEELC's (N = {}; the paper: about 95 % down to ε = 2 %, 70 % at 0.5 %): {}.",
+            p.eelc_points,
+            eelc_parts.join("; ")
+        );
+    }
+    let _ = writeln!(summary, "\n{}", goal_line(rows, refs, p));
     Section {
         title,
         summary,
@@ -1027,12 +1594,16 @@ mod tests {
         assert!((a - 2.0 / 3.0).abs() < 1e-12);
         let want = ((0.04f64.powi(2) + 0.1f64.powi(2) + 0.06f64.powi(2) + 0.25) / 4.0).sqrt();
         assert!((rmse - want).abs() < 1e-12, "{rmse} vs {want}");
+        // Σ(Î − I) = 0.04 − 0.1 + 0.06 + 0.5 over Σ I = 4.
+        assert!((bias(&out, &r) - 0.125).abs() < 1e-12, "{}", bias(&out, &r));
         // Pooled over two runs of different sizes: weighted by estimates.
         let row = |accuracy: f64, pixels: usize| Row {
             scene: "s",
             experiment: "accuracy",
+            method: OURS,
             selection: "bssrdf",
             eps: 0.05,
+            points: 0,
             vpls: 1,
             triangles: 1,
             seed: 1,
@@ -1041,6 +1612,7 @@ mod tests {
             mean_triplets: 0.0,
             accuracy,
             rmse: 0.0,
+            bias: 0.0,
             capped: 0,
         };
         let (r1, r2) = (row(1.0, 30), row(0.5, 10));
@@ -1048,5 +1620,83 @@ mod tests {
         assert_eq!(n, 40);
         assert!((a - 35.0 / 40.0).abs() < 1e-12);
         assert!((se - (a * (1.0 - a) / 40.0).sqrt()).abs() < 1e-12);
+    }
+
+    /// Table 1 and the goal line from hand-made rows: ours at ε = 2 % takes 2 s for RMSE 0.01
+    /// (mean of two streams); EELC-IS's sweep RMSE = 0.1 t^−½ crosses 0.01 at 100 s (50×,
+    /// met); MDLC-IS stops at 0.02 after 16 s (not reached, > 8×, ≈ 32× extrapolated: 4× the
+    /// time per halving of the error, 16 s × 4 = 64 s); EELC-uniform starts below the target.
+    #[test]
+    fn table1_reads_equal_quality_and_time_off_the_sweeps() {
+        let mut p = plan(false);
+        p.eps = vec![0.05, 0.02];
+        let row = |method: &'static str, experiment, eps, points, seed, seconds, rmse| Row {
+            scene: "s",
+            experiment,
+            method,
+            selection: "-",
+            eps,
+            points,
+            vpls: 1,
+            triangles: 1,
+            seed,
+            seconds,
+            pixels: 10,
+            mean_triplets: 1.0,
+            accuracy: 0.9,
+            rmse,
+            bias: 0.0,
+            capped: 0,
+        };
+        let mut rows = vec![
+            row(OURS, "accuracy", 0.05, 0, 1, 0.5, 0.04),
+            row(OURS, "accuracy", 0.02, 0, 1, 1.5, 0.008),
+            row(OURS, "accuracy", 0.02, 0, 2, 2.5, 0.012),
+        ];
+        for (n, t) in [(64, 1.0), (256, 16.0), (1024, 400.0)] {
+            rows.push(row("eelc-is", "quality", 0.02, n, 1, t, 0.1 / f64::sqrt(t)));
+        }
+        // Given out of order: the sweep is read fewest points first.
+        rows.push(row("mdlc-is", "quality", 0.02, 256, 1, 16.0, 0.02));
+        rows.push(row("mdlc-is", "quality", 0.02, 64, 1, 4.0, 0.04));
+        rows.push(row("eelc-uniform", "quality", 0.02, 64, 1, 3.0, 0.005));
+        let (t_ours, e_ours) = ours_at_fixed(&rows, "s", &p).unwrap();
+        assert!((t_ours - 2.0).abs() < 1e-12 && (e_ours - 0.01).abs() < 1e-12);
+        let (r, x) = equal_quality(&rows, "s", "eelc-is", 0.01);
+        let Some(Reach::At(t)) = r else {
+            panic!("{r:?}")
+        };
+        assert!((t - 100.0).abs() < 1e-9, "{t}");
+        assert_eq!(x, None);
+        let (r, x) = equal_quality(&rows, "s", "mdlc-is", 0.01);
+        assert_eq!(r, Some(Reach::NotReached(16.0)));
+        assert!((x.unwrap() - 64.0).abs() < 1e-9);
+        assert_eq!(
+            reach_cells(r, x, 2.0),
+            [
+                "not reached (> 16.0; ≈ 64.0 extrapolated)".to_string(),
+                "> 8.00× (≈ 32.0×)".to_string()
+            ]
+        );
+        let (r, _) = equal_quality(&rows, "s", "eelc-uniform", 0.01);
+        assert_eq!(r, Some(Reach::AtMost(3.0)));
+        let refs = vec![(
+            "s",
+            Reference {
+                pixels: vec![],
+                values: vec![],
+                rel_se: vec![],
+                seconds: 0.0,
+            },
+            1,
+        )];
+        let goal = goal_line(&rows, &refs, &p);
+        assert!(goal.contains("s 50.0× (met)"), "{goal}");
+        let t = table1(&rows, &refs, &p);
+        // Equal time: EELC-IS at ours' 2 s is 0.1/√2.
+        let want = md_num(Some(0.1 / 2f64.sqrt()), 3);
+        assert!(t.contains(&want), "{want} in {t}");
+        assert!(t.contains("outside its runs (4.00–16.0 s)"), "{t}");
+        assert!(t.contains("≤ 3.00 (its cheapest run)"), "{t}");
     }
 }
