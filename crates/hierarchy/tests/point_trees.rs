@@ -116,11 +116,12 @@ fn pixel_points(w: u32, h: u32, spp: u32) -> Vec<PixelPoint> {
         for x in 0..w {
             for _ in 0..spp {
                 let n = DVec3::new(uniform(&mut s) - 0.5, 1.0, 0.1).normalize();
+                let v = DVec3::new(0.3 * uniform(&mut s), -0.2 * uniform(&mut s), 1.0);
                 out.push(PixelPoint {
                     screen: [x as f64 + 0.5, y as f64 + 0.5],
                     position: DVec3::new(x as f64, y as f64, 5.0 + uniform(&mut s)),
                     normal: n,
-                    view: DVec3::Z,
+                    view: v.normalize(),
                     rate: uniform(&mut s) * 0.4,
                 });
             }
@@ -145,6 +146,8 @@ fn pixel_aggregates_equal_brute_force_and_length_is_in_pixels() {
         assert!(cl.position.distance(mean) < 1e-9);
         let mean_n = items.iter().map(|p| p.normal).sum::<DVec3>() / n;
         assert!(cl.normal.distance(mean_n) < 1e-12);
+        let mean_v = items.iter().map(|p| p.view).sum::<DVec3>() / n;
+        assert!(cl.view.distance(mean_v) < 1e-12);
         let rate = items.iter().map(|p| p.rate).fold(0.0, f64::max);
         assert_eq!(cl.max_rate, rate);
         let lo = items.iter().fold(DVec3::INFINITY, |a, p| a.min(p.position));
