@@ -320,7 +320,8 @@ fn every_inner_node_splits_at_the_median_of_its_longest_side() {
         left: sss_hierarchy::kdtree::LEAF,
         right: sss_hierarchy::kdtree::LEAF,
     };
-    assert!(none.is_empty() && none.len() == 0 && none.is_leaf());
+    assert!(none.is_empty() && none.is_leaf());
+    assert_eq!(none.len(), 0);
 }
 
 /// The byte estimates cover what a build holds at its end and follow the leaf size. The

@@ -323,7 +323,11 @@ fn the_union_of_two_cones_is_the_smallest_cone_around_both() {
     let c = ca.union(cb);
     assert!((c.half_angle - 45f64.to_radians()).abs() < 1e-12, "{c:?}");
     let expect = towards(a, b, 35f64.to_radians());
-    assert!(c.axis.distance(expect) < 1e-12, "{:?} vs {expect:?}", c.axis);
+    assert!(
+        c.axis.distance(expect) < 1e-12,
+        "{:?} vs {expect:?}",
+        c.axis
+    );
     // Both far edges lie on its boundary; directions of either cone lie inside; a direction
     // just beyond a far edge does not.
     let edge_a = towards(a, b, -10f64.to_radians());
@@ -389,7 +393,10 @@ fn unions_of_opposite_or_wide_cones_hold_both_and_stay_in_range() {
         for (k, (axis, half)) in [(a, ta), (b, tb)].into_iter().enumerate() {
             for _ in 0..500 {
                 let n = in_cone(axis, half, &mut u);
-                assert!(c.contains(n), "cone {k} of {a:?}/{b:?}: {n:?} outside {c:?}");
+                assert!(
+                    c.contains(n),
+                    "cone {k} of {a:?}/{b:?}: {n:?} outside {c:?}"
+                );
             }
         }
     }
@@ -444,7 +451,10 @@ fn the_bound_covers_the_computed_cosine_at_the_cones_edge() {
             // The cone's normal nearest to the direction of p.
             let n = towards(axis, side, half.min(at));
             let c = n.dot(p.normalize()).clamp(0.0, 1.0);
-            assert!(bound >= c, "{half_deg}° cone, point at {at_deg}°: {bound} < {c}");
+            assert!(
+                bound >= c,
+                "{half_deg}° cone, point at {at_deg}°: {bound} < {c}"
+            );
             assert!(bound <= c + 1e-9, "{half_deg}°, {at_deg}°: {bound} vs {c}");
         }
     }
