@@ -185,6 +185,19 @@ fn bad_input_is_an_error() {
             spatial_cycles_per_mm: 1.0,
             angular_cycles_per_radian: f64::NAN,
         },
+        // Each check on its own: an infinite B_s, a negative or infinite B_θ.
+        BandwidthVector {
+            spatial_cycles_per_mm: f64::INFINITY,
+            angular_cycles_per_radian: 1.0,
+        },
+        BandwidthVector {
+            spatial_cycles_per_mm: 1.0,
+            angular_cycles_per_radian: -1.0,
+        },
+        BandwidthVector {
+            spatial_cycles_per_mm: 1.0,
+            angular_cycles_per_radian: f64::INFINITY,
+        },
     ] {
         assert!(screen_angular_bandwidth(bad, &geometry(0.0, 1.0, 1.0), MIN_COS_THETA_O).is_err());
     }

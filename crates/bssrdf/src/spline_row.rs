@@ -353,6 +353,37 @@ impl SplineRow {
 mod tests {
     use super::*;
 
+    /// The linear first segment: a straight line between the first two knot values, the
+    /// other segments unchanged, and the running integral that of the new spline (Gauss
+    /// quadrature of `eval` per segment), so sampling still inverts it.
+    #[test]
+    fn linear_first_segment_is_a_line_and_its_integral_is_exact() {
+        let knots = [0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0];
+        let values = [0.0, 0.9, 0.7, 0.3, 0.6, 0.2, 0.05];
+        let index = KnotIndex::new(&knots).unwrap();
+        let row = SplineRow::new(&index, &values).with_linear_first_segment();
+        for k in 0..=10 {
+            let x = 0.05 * k as f64;
+            assert!((row.eval(x) - 0.9 * x / 0.5).abs() < 1e-14, "x {x}");
+        }
+        assert_eq!(row.eval(2.7), SplineRow::new(&index, &values).eval(2.7));
+        let f = |x: f64| row.eval(x);
+        let cdf = |x: f64| {
+            let mut acc = 0.0;
+            for w in knots.windows(2) {
+                if x > w[0] {
+                    acc += crate::quadrature::integrate(&f, w[0], x.min(w[1]), 8);
+                }
+            }
+            acc
+        };
+        assert!((row.total() - cdf(4.0)).abs() < 1e-13, "{}", row.total());
+        for u in [0.01, 0.3, 0.5, 0.77, 0.99] {
+            let x = row.sample(u).unwrap();
+            assert!((cdf(x) / row.total() - u).abs() < 1e-10, "u {u}: x {x}");
+        }
+    }
+
     #[test]
     fn non_negative_row_is_non_negative_and_sampled_exactly() {
         // A spike: Catmull-Rom overshoots below 0 next to it.

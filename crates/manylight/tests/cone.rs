@@ -269,3 +269,262 @@ fn default_caps_take_about_110_mb() {
     small.max_triplets = 1;
     assert!(small.peak_pixel_bytes() < 1000);
 }
+
+/// Unit vector at `angle` from `a` towards `b` (both unit, not parallel), in their plane.
+fn towards(a: DVec3, b: DVec3, angle: f64) -> DVec3 {
+    let p = (b - a * a.dot(b)).normalize();
+    a * angle.cos() + p * angle.sin()
+}
+
+/// The angle between two unit vectors, as `acos` of the clamped dot product: an independent
+/// measure (the crate uses atan2).
+fn angle(a: DVec3, b: DVec3) -> f64 {
+    a.dot(b).clamp(-1.0, 1.0).acos()
+}
+
+/// `NormalCone::union` against the geometry of two cones sharing a plane: the smallest cone
+/// around both spans, in that plane, from the first cone's far edge to the second's, so its
+/// half-angle is (φ + θ₁ + θ₂)/2 and its axis lies (φ + θ₂ − θ₁)/2 from the first axis towards
+/// the second (φ the angle between the axes).
+#[test]
+fn the_union_of_two_cones_is_the_smallest_cone_around_both() {
+    // Two directions 90° apart: the bisector, half-angle 45°.
+    let x = NormalCone {
+        axis: DVec3::X,
+        half_angle: 0.0,
+    };
+    let y = NormalCone {
+        axis: DVec3::Y,
+        half_angle: 0.0,
+    };
+    let c = x.union(y);
+    assert!(
+        (c.half_angle - std::f64::consts::FRAC_PI_4).abs() < 1e-12,
+        "{c:?}"
+    );
+    assert!(
+        c.axis.distance(DVec3::new(1.0, 1.0, 0.0).normalize()) < 1e-12,
+        "{c:?}"
+    );
+    // 10° and 20° cones whose axes are 60° apart: half-angle 45°, axis 35° from the first.
+    let a = DVec3::new(1.0, 2.0, -0.5).normalize();
+    let far = DVec3::new(-0.3, 0.4, 1.0).normalize();
+    let b = towards(a, far, 60f64.to_radians());
+    let (ca, cb) = (
+        NormalCone {
+            axis: a,
+            half_angle: 10f64.to_radians(),
+        },
+        NormalCone {
+            axis: b,
+            half_angle: 20f64.to_radians(),
+        },
+    );
+    let c = ca.union(cb);
+    assert!((c.half_angle - 45f64.to_radians()).abs() < 1e-12, "{c:?}");
+    let expect = towards(a, b, 35f64.to_radians());
+    assert!(
+        c.axis.distance(expect) < 1e-12,
+        "{:?} vs {expect:?}",
+        c.axis
+    );
+    // Both far edges lie on its boundary; directions of either cone lie inside; a direction
+    // just beyond a far edge does not.
+    let edge_a = towards(a, b, -10f64.to_radians());
+    let edge_b = towards(a, b, 80f64.to_radians());
+    for e in [edge_a, edge_b] {
+        assert!((angle(c.axis, e) - c.half_angle).abs() < 1e-9);
+        assert!(c.contains(e));
+    }
+    assert!(!c.contains(towards(a, b, -10.1f64.to_radians())));
+    assert!(!c.contains(towards(a, b, 80.1f64.to_radians())));
+    // The other order gives the same cone.
+    let d = cb.union(ca);
+    assert!((d.half_angle - c.half_angle).abs() < 1e-12);
+    assert!(d.axis.distance(c.axis) < 1e-12);
+    // A cone that holds the other is its own union with it, whichever comes first.
+    let big = NormalCone {
+        axis: a,
+        half_angle: 1.0,
+    };
+    let small = NormalCone {
+        axis: towards(a, far, 0.3),
+        half_angle: 0.5,
+    };
+    assert_eq!(big.union(small), big);
+    assert_eq!(small.union(big), big);
+}
+
+/// Cones whose union needs the whole sphere, or that point in opposite directions (no plane
+/// to rotate in): the union is a finite cone, of half-angle at most π (the field's range),
+/// that holds every direction of both.
+#[test]
+fn unions_of_opposite_or_wide_cones_hold_both_and_stay_in_range() {
+    let mut u = U(11);
+    let cases = [
+        // Opposite axes, 1 rad each: the smallest cone has half-angle (π + 2)/2 < π.
+        (DVec3::X, 1.0, DVec3::NEG_X, 1.0),
+        (DVec3::Z, 0.0, DVec3::NEG_Z, 0.0),
+        // 90° apart, 2.5 rad each: together they cover the sphere ((φ + θ₁ + θ₂)/2 > π).
+        (DVec3::X, 2.5, DVec3::Y, 2.5),
+    ];
+    for (a, ta, b, tb) in cases {
+        let (ca, cb) = (
+            NormalCone {
+                axis: a,
+                half_angle: ta,
+            },
+            NormalCone {
+                axis: b,
+                half_angle: tb,
+            },
+        );
+        let c = ca.union(cb);
+        assert!(c.axis.is_finite() && c.half_angle.is_finite(), "{c:?}");
+        assert!((c.axis.length() - 1.0).abs() < 1e-12, "{c:?}");
+        assert!(
+            c.half_angle <= std::f64::consts::PI,
+            "{c:?}: half-angle beyond π"
+        );
+        assert!(
+            c.half_angle >= (0.5 * (angle(a, b) + ta + tb)).min(std::f64::consts::PI) - 1e-12,
+            "{c:?} is narrower than the smallest cone"
+        );
+        for (k, (axis, half)) in [(a, ta), (b, tb)].into_iter().enumerate() {
+            for _ in 0..500 {
+                let n = in_cone(axis, half, &mut u);
+                assert!(
+                    c.contains(n),
+                    "cone {k} of {a:?}/{b:?}: {n:?} outside {c:?}"
+                );
+            }
+        }
+    }
+}
+
+/// `contains` against directions at known angles from the axis.
+#[test]
+fn contains_holds_exactly_the_directions_within_the_half_angle() {
+    let axis = DVec3::new(0.2, 1.0, 0.3).normalize();
+    let side = DVec3::new(1.0, -0.1, 0.4).normalize();
+    let cone = NormalCone {
+        axis,
+        half_angle: 30f64.to_radians(),
+    };
+    for (deg, inside) in [
+        (0.0, true),
+        (29.9, true),
+        (30.0, true),
+        (30.1, false),
+        (90.0, false),
+        (150.0, false),
+        (180.0, false),
+    ] {
+        let d = towards(axis, side, f64::to_radians(deg));
+        assert_eq!(cone.contains(d), inside, "{deg}°");
+    }
+    let none = NormalCone {
+        axis,
+        half_angle: 0.0,
+    };
+    assert!(none.contains(axis));
+    assert!(!none.contains(towards(axis, side, 1e-6)));
+}
+
+/// The bound is an upper bound of the cosines computed in f64, with no tolerance: at the
+/// cone's edge towards a point, n · d equals cos(angle − half-angle) to rounding, and the
+/// slack of [`cone::ANGLE_SLACK`] keeps the bound above it; it is still tight (within 1e-9).
+#[test]
+fn the_bound_covers_the_computed_cosine_at_the_cones_edge() {
+    let origin = Aabb::point(DVec3::ZERO);
+    let axis = DVec3::new(0.3, 1.0, -0.2).normalize();
+    let side = DVec3::new(1.0, 0.1, 0.7).normalize();
+    for half_deg in [0.0, 10.0, 30.0, 55.0] {
+        for at_deg in [5.0, 20.0, 45.0, 60.0, 75.0, 100.0, 130.0] {
+            let (half, at) = (f64::to_radians(half_deg), f64::to_radians(at_deg));
+            let cone = NormalCone {
+                axis,
+                half_angle: half,
+            };
+            let p = 2.5 * towards(axis, side, at);
+            let bound = cos_upper(&cone, &origin, &Aabb::point(p));
+            // The cone's normal nearest to the direction of p.
+            let n = towards(axis, side, half.min(at));
+            let c = n.dot(p.normalize()).clamp(0.0, 1.0);
+            assert!(
+                bound >= c,
+                "{half_deg}° cone, point at {at_deg}°: {bound} < {c}"
+            );
+            assert!(bound <= c + 1e-9, "{half_deg}°, {at_deg}°: {bound} vs {c}");
+        }
+    }
+}
+
+/// A box lying on the axis's negative ray and ending at the other box: every direction
+/// between them is exactly opposite the axis, so no cosine is positive (the zero vector, from
+/// the shared end point, has no direction).
+#[test]
+fn a_box_straight_behind_the_axis_gets_a_zero_bound() {
+    let cone = NormalCone {
+        axis: DVec3::X,
+        half_angle: 0.0,
+    };
+    let segment = Aabb {
+        min: DVec3::ZERO,
+        max: DVec3::X,
+    };
+    let end = Aabb::point(DVec3::ZERO);
+    let c = cos_upper(&cone, &segment, &end);
+    assert!((0.0..=1e-9).contains(&c), "{c}");
+    // Away from the end point: also 0.
+    let c = cos_upper(&cone, &segment, &Aabb::point(-DVec3::X));
+    assert!((0.0..=1e-9).contains(&c), "{c}");
+}
+
+/// The documented trivial bound 1 for empty boxes (`Aabb::is_empty`: `min > max` on some
+/// axis, with finite corners too) and non-finite ones, in configurations where the bound
+/// computed from the corners would be about 0.
+#[test]
+fn empty_and_non_finite_boxes_get_the_trivial_bound() {
+    let up = NormalCone {
+        axis: DVec3::Y,
+        half_angle: 0.0,
+    };
+    let origin = Aabb::point(DVec3::ZERO);
+    let below = Aabb::point(DVec3::new(0.0, -2.0, 0.0));
+    // The corners alone give 0 (the other box lies below).
+    assert_eq!(cos_upper(&up, &origin, &below), 0.0);
+    let inverted_at_origin = Aabb {
+        min: DVec3::ZERO,
+        max: DVec3::new(-1.0, 0.0, 0.0),
+    };
+    assert!(inverted_at_origin.is_empty());
+    assert_eq!(cos_upper(&up, &inverted_at_origin, &below), 1.0);
+    let inverted_below = Aabb {
+        min: DVec3::new(1.0, -2.0, 0.0),
+        max: DVec3::new(0.0, -2.0, 0.0),
+    };
+    assert!(inverted_below.is_empty());
+    assert_eq!(cos_upper(&up, &origin, &inverted_below), 1.0);
+    assert_eq!(cos_upper(&up, &Aabb::EMPTY, &below), 1.0);
+    assert_eq!(cos_upper(&up, &origin, &Aabb::EMPTY), 1.0);
+    // A ray of points below the plane, reaching to +∞ along x: one infinite corner, with the
+    // other box's corners and the cone's axis finite.
+    let ray_below = Aabb {
+        min: DVec3::new(0.0, -1.0, 0.0),
+        max: DVec3::new(f64::INFINITY, -1.0, 0.0),
+    };
+    assert_eq!(cos_upper(&up, &origin, &ray_below), 1.0);
+    assert_eq!(cos_upper(&up, &ray_below, &origin), 1.0);
+    let ray_behind = Aabb {
+        min: DVec3::new(f64::NEG_INFINITY, -1.0, 0.0),
+        max: DVec3::new(0.0, -1.0, 0.0),
+    };
+    assert_eq!(cos_upper(&up, &origin, &ray_behind), 1.0);
+    // A non-finite axis.
+    let nan = NormalCone {
+        axis: DVec3::NAN,
+        half_angle: 0.0,
+    };
+    assert_eq!(cos_upper(&nan, &origin, &below), 1.0);
+}
