@@ -547,36 +547,26 @@ fn separable(c: &mut Criterion) {
             b.iter(|| threads.install(|| var.run(black_box(f), &mut tmp, &mut out)))
         });
     }
-    g.bench_function("pre-integrated-7taps-per-pixel/2-threads", |b| {
-        b.iter(|| {
-            two.install(|| {
-                screen_space::filter_into_with(
-                    black_box(&frame.input()),
-                    &pre7,
-                    &opts,
-                    &mut scratch,
-                    &mut out,
-                    screen_space::Evaluation::PerPixel,
-                )
-                .expect("filter")
+    for (name, f) in [
+        ("pre-integrated-7taps-per-pixel/2-threads", &frame),
+        ("tilted/pre-integrated-7taps-per-pixel/2-threads", &tilted),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                two.install(|| {
+                    screen_space::filter_into_with(
+                        black_box(&f.input()),
+                        &pre7,
+                        &opts,
+                        &mut scratch,
+                        &mut out,
+                        screen_space::Evaluation::PerPixel,
+                    )
+                    .expect("filter")
+                })
             })
-        })
-    });
-    g.bench_function("tilted/pre-integrated-7taps-per-pixel/2-threads", |b| {
-        b.iter(|| {
-            two.install(|| {
-                screen_space::filter_into_with(
-                    black_box(&tilted.input()),
-                    &pre7,
-                    &opts,
-                    &mut scratch,
-                    &mut out,
-                    screen_space::Evaluation::PerPixel,
-                )
-                .expect("filter")
-            })
-        })
-    });
+        });
+    }
     for (name, f, kernel, threads) in [
         ("pre-integrated-7taps/1-thread", &frame, &pre7, &one),
         ("pre-integrated-7taps/2-threads", &frame, &pre7, &two),

@@ -353,6 +353,17 @@ impl SplineRow {
 mod tests {
     use super::*;
 
+    /// ∫₀ˣ of the row by Gauss–Legendre quadrature over each knot interval: an integral
+    /// independent of the row's own running sums.
+    fn quadrature_cdf(row: &SplineRow, knots: &[f64], x: f64) -> f64 {
+        let f = |t: f64| row.eval(t);
+        knots
+            .windows(2)
+            .filter(|w| x > w[0])
+            .map(|w| crate::quadrature::integrate(&f, w[0], x.min(w[1]), 8))
+            .sum()
+    }
+
     /// The linear first segment: a straight line between the first two knot values, the
     /// other segments unchanged, and the running integral that of the new spline (Gauss
     /// quadrature of `eval` per segment), so sampling still inverts it.
@@ -367,16 +378,7 @@ mod tests {
             assert!((row.eval(x) - 0.9 * x / 0.5).abs() < 1e-14, "x {x}");
         }
         assert_eq!(row.eval(2.7), SplineRow::new(&index, &values).eval(2.7));
-        let f = |x: f64| row.eval(x);
-        let cdf = |x: f64| {
-            let mut acc = 0.0;
-            for w in knots.windows(2) {
-                if x > w[0] {
-                    acc += crate::quadrature::integrate(&f, w[0], x.min(w[1]), 8);
-                }
-            }
-            acc
-        };
+        let cdf = |x: f64| quadrature_cdf(&row, &knots, x);
         assert!((row.total() - cdf(4.0)).abs() < 1e-13, "{}", row.total());
         for u in [0.01, 0.3, 0.5, 0.77, 0.99] {
             let x = row.sample(u).unwrap();
@@ -402,16 +404,7 @@ mod tests {
         assert_eq!(limited.eval(3.5), row.eval(3.5));
         // The running integral is that of the limited spline (quadrature), and sampling
         // inverts it.
-        let f = |x: f64| limited.eval(x);
-        let cdf = |x: f64| {
-            let mut acc = 0.0;
-            for w in knots.windows(2) {
-                if x > w[0] {
-                    acc += crate::quadrature::integrate(&f, w[0], x.min(w[1]), 8);
-                }
-            }
-            acc
-        };
+        let cdf = |x: f64| quadrature_cdf(&limited, &knots, x);
         assert!(
             (limited.total() - cdf(4.0)).abs() < 1e-13,
             "{}",

@@ -334,34 +334,31 @@ fn every_inner_node_splits_at_the_median_of_its_longest_side() {
 fn byte_estimates_follow_the_leaf_size() {
     let n = 5000;
     let input = irradiance_points(n, 2);
-    let mut last = (u64::MAX, u64::MAX);
-    for leaf in [1, 2, 4, 8, 16] {
+    estimates_bound_what_is_held(|leaf| {
         let t = IrradianceTree::build(&input, leaf);
         let held = (t.tree.nodes.len() * std::mem::size_of_val(&t.tree.nodes[0])
             + t.clusters.len() * std::mem::size_of_val(&t.clusters[0])
             + n * (4 + 2 * std::mem::size_of::<IrradiancePoint>())) as u64;
-        let est = IrradianceTree::bytes_for(n, leaf);
-        assert!(
-            held <= est && est < 2 * held,
-            "leaf {leaf}: estimate {est} B for {held} B held"
-        );
-        if leaf > 2 {
-            assert!(
-                held < last.0 && est < last.1,
-                "leaf {leaf}: {held} B, {est} B"
-            );
-        }
-        last = (held, est);
-    }
+        (held, IrradianceTree::bytes_for(n, leaf))
+    });
     let input = pixel_points(60, 50, 1);
     let n = input.len();
-    let mut last = (u64::MAX, u64::MAX);
-    for leaf in [1, 2, 4, 8, 16] {
+    estimates_bound_what_is_held(|leaf| {
         let t = PixelTree::build(&input, leaf);
         let held = (t.tree.nodes.len() * std::mem::size_of_val(&t.tree.nodes[0])
             + t.clusters.len() * std::mem::size_of_val(&t.clusters[0])
             + n * (4 + std::mem::size_of::<[f64; 2]>())) as u64;
-        let est = PixelTree::bytes_for(n, leaf);
+        (held, PixelTree::bytes_for(n, leaf))
+    });
+}
+
+/// For leaf sizes 1 … 16, `held_and_estimate(leaf)` gives the bytes a built tree holds and its
+/// estimate: the estimate bounds what is held, by less than 2×, and both shrink at each
+/// doubling of the leaf size from 2 → 4 on.
+fn estimates_bound_what_is_held(held_and_estimate: impl Fn(usize) -> (u64, u64)) {
+    let mut last = (u64::MAX, u64::MAX);
+    for leaf in [1, 2, 4, 8, 16] {
+        let (held, est) = held_and_estimate(leaf);
         assert!(
             held <= est && est < 2 * held,
             "leaf {leaf}: estimate {est} B for {held} B held"
