@@ -223,6 +223,11 @@ fn bad_input_is_an_error() {
             fov_x_rad: 7.0,
             ..HD
         },
+        // The documented interval (0, 2π) is open: a full turn is refused.
+        PixelFootprint {
+            fov_y_rad: std::f64::consts::TAU,
+            ..HD
+        },
         PixelFootprint { width_px: 0, ..HD },
         PixelFootprint { height_px: 0, ..HD },
     ] {
