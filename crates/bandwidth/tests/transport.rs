@@ -240,5 +240,19 @@ fn bad_input_is_an_error() {
         MaterialBandwidth::from_parts(ModelKind::Burley, [f64::NAN, 0.0, 0.0], table.clone(), 0.1)
             .is_err()
     );
-    assert!(MaterialBandwidth::from_parts(ModelKind::Burley, [1.0; 3], table, 2.0).is_err());
+    assert!(
+        MaterialBandwidth::from_parts(ModelKind::Burley, [1.0; 3], table.clone(), 2.0).is_err()
+    );
+    // Each condition on its own: a finite negative bandwidth, an infinite one, and
+    // min_cos = 0 (the interval (0, 1] is open at 0).
+    for b in [[-1.0, 0.0, 0.0], [0.0, f64::INFINITY, 0.0]] {
+        assert!(
+            MaterialBandwidth::from_parts(ModelKind::Burley, b, table.clone(), 0.1).is_err(),
+            "{b:?}"
+        );
+    }
+    assert!(
+        MaterialBandwidth::from_parts(ModelKind::Burley, [1.0; 3], table.clone(), 0.0).is_err()
+    );
+    assert!(MaterialBandwidth::from_parts(ModelKind::Burley, [1.0; 3], table, 1.0).is_ok());
 }
