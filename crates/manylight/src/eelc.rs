@@ -94,19 +94,8 @@ impl EelcSettings {
     }
 
     fn validate(&self) -> Result<(), Error> {
+        crate::pairs::validate_settings(self.epsilon, self.g_max, self.max_pairs)?;
         let bad = |m: String| Err(Error::InvalidInput(m));
-        if !(self.epsilon.is_finite() && self.epsilon >= 0.0) {
-            return bad(format!("ε = {} must be finite and ≥ 0", self.epsilon));
-        }
-        if !(self.g_max.is_finite() && self.g_max > 0.0) {
-            return bad(format!("G_max = {} must be finite and > 0", self.g_max));
-        }
-        if self.max_pairs == 0 || self.max_pairs > (1 << 30) {
-            return bad(format!(
-                "max_pairs = {} must be in 1..=2^30",
-                self.max_pairs
-            ));
-        }
         if self.min_pairs == 0 {
             return bad("min_pairs must be ≥ 1".into());
         }

@@ -106,3 +106,23 @@ pub(crate) fn light_rgb_sums(nodes: &[LightNode], vpls: &[Vpl]) -> Vec<[f64; 3]>
 pub(crate) fn mul3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
 }
+
+/// The settings MDLC and EELC share: ε finite and ≥ 0, G_max finite and > 0, `max_pairs` in
+/// 1..=2³⁰.
+pub(crate) fn validate_settings(
+    epsilon: f64,
+    g_max: f64,
+    max_pairs: usize,
+) -> Result<(), crate::Error> {
+    let bad = |m: String| Err(crate::Error::InvalidInput(m));
+    if !(epsilon.is_finite() && epsilon >= 0.0) {
+        return bad(format!("ε = {epsilon} must be finite and ≥ 0"));
+    }
+    if !(g_max.is_finite() && g_max > 0.0) {
+        return bad(format!("G_max = {g_max} must be finite and > 0"));
+    }
+    if max_pairs == 0 || max_pairs > (1 << 30) {
+        return bad(format!("max_pairs = {max_pairs} must be in 1..=2^30"));
+    }
+    Ok(())
+}
