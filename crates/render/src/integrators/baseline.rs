@@ -558,3 +558,10 @@ pub(crate) fn shade_pixels<E: PixelEstimator>(
         })
         .collect())
 }
+
+/// The irradiance-point counts `mdlc` and `eelc` sweep in `cargo xtask compare` (cheapest
+/// first, at ε = 0.02): 64 with `--quick`, else 64 and 256 (the reasons are at `mdlc`'s
+/// registry entry).
+pub(super) fn sweep_points(quick: bool) -> Vec<f64> {
+    if quick { vec![64.0] } else { vec![64.0, 256.0] }
+}

@@ -46,10 +46,7 @@ pub const METHOD: Method = Method {
     sweep: Sweep {
         option: "irradiance-points",
         label: "points",
-        // As `mdlc`'s: cheapest first at ε = 0.02.
-        values: |quick| {
-            if quick { vec![64.0] } else { vec![64.0, 256.0] }
-        },
+        values: baseline::sweep_points,
     },
 };
 

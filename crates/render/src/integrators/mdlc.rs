@@ -53,9 +53,7 @@ pub const METHOD: Method = Method {
         // ~5 s on 2 cores), and the sweep runs on every radial scene with all threads and one,
         // so it stays at the cheap end; the paper's 4096 per shading point is for `sss render`
         // (README: measured times).
-        values: |quick| {
-            if quick { vec![64.0] } else { vec![64.0, 256.0] }
-        },
+        values: baseline::sweep_points,
     },
 };
 
