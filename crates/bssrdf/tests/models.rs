@@ -403,3 +403,35 @@ fn models_against_monte_carlo() {
         assert!(rel < 0.1, "ch{ch}: {pbd_total} vs {}", mc.total[ch]);
     }
 }
+
+/// The three-channel forms agree with the per-channel profile: `rd_rgb(r)` is
+/// `[rd(0, r), rd(1, r), rd(2, r)]` and `sp` is R_d of the distance between the two points,
+/// for every model (renderers call these, the other tests mostly `rd`).
+#[test]
+fn rgb_and_spatial_forms_are_the_channel_profiles() {
+    let m = Medium::preset("skin1").unwrap();
+    let xi = SurfacePoint {
+        p: DVec3::new(0.3, -0.2, 1.0),
+        n: DVec3::Z,
+    };
+    for kind in ModelKind::ALL {
+        let model = make_model(kind, &m);
+        for r in [0.01, 0.2, 1.0, 3.0] {
+            let rgb = model.rd_rgb(r);
+            let xo = SurfacePoint {
+                p: xi.p + DVec3::new(0.6 * r, 0.8 * r, 0.0),
+                n: DVec3::Z,
+            };
+            let sp = model.sp(&xi, &xo);
+            for ch in 0..3 {
+                let want = model.rd(ch, r);
+                assert!(want > 0.0, "{kind} ch{ch} r {r}: R_d = {want}");
+                assert_eq!(rgb[ch], want, "{kind} ch{ch} r {r}: rd_rgb");
+                assert!(
+                    (sp[ch] - want).abs() <= 1e-12 * want,
+                    "{kind} ch{ch} r {r}: sp"
+                );
+            }
+        }
+    }
+}

@@ -138,3 +138,47 @@ fn the_artist_fitter_runs_on_a_diffusion_profile() {
         assert!(fit.rel_error[c].is_finite() && fit.rel_error[c] < 0.5);
     }
 }
+
+/// Eq. 6's a_m against its closed form: a mix of two normalised Gaussians, so its integral is
+/// 1, its second moment is w σ_n² + (1 − w) σ_f², and its value at 0 is
+/// w/(√(2π) σ_n) + (1 − w)/(√(2π) σ_f). Integrated here by the trapezoid rule on a grid a
+/// hundredth of the near σ wide (error ≪ 10⁻⁶ for a Gaussian).
+#[test]
+fn the_artist_profile_is_a_normalised_two_gaussian_mix() {
+    for preset in artist::PRESETS {
+        let p = preset.params;
+        // √(2π), written out.
+        const SQRT_2PI: f64 = 2.506_628_274_631;
+        for c in 0..3 {
+            let (sn, sf, w) = (p.sigma_near[c], p.sigma_far[c], p.w[c]);
+            let at0 = w / (SQRT_2PI * sn) + (1.0 - w) / (SQRT_2PI * sf);
+            assert!(
+                (p.eval(c, 0.0) - at0).abs() < 1e-12 * at0,
+                "{} channel {c}: a_m(0) = {} vs {at0}",
+                preset.name,
+                p.eval(c, 0.0)
+            );
+            let h = sn.min(sf) / 100.0;
+            let n = (10.0 * sn.max(sf) / h).ceil() as i64;
+            let (mut m0, mut m2) = (0.0, 0.0);
+            for i in -n..=n {
+                let x = i as f64 * h;
+                let v = p.eval(c, x);
+                m0 += v * h;
+                m2 += x * x * v * h;
+            }
+            assert!(
+                (m0 - 1.0).abs() < 1e-6,
+                "{} channel {c}: ∫ a_m = {m0}",
+                preset.name
+            );
+            let var = w * sn * sn + (1.0 - w) * sf * sf;
+            assert!(
+                (m2 - var).abs() < 1e-6 * var,
+                "{} channel {c}: ∫ x² a_m = {m2} vs {var}",
+                preset.name
+            );
+            assert!((p.variance(c) - var).abs() < 1e-12 * var);
+        }
+    }
+}
