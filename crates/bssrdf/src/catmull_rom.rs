@@ -488,5 +488,13 @@ mod tests {
             sample_catmull_rom_2d(&n1, &n2, &values, &cdf, 1.5, 0.5),
             (0.0, 0.0, 0.0)
         );
+        // Inconsistent arrays (one value or one CDF entry short) give zeros, not a panic.
+        let n = values.len();
+        for (v, c) in [(&values[..n - 1], &cdf[..]), (&values[..], &cdf[..n - 1])] {
+            assert_eq!(
+                sample_catmull_rom_2d(&n1, &n2, v, c, 0.5, 0.5),
+                (0.0, 0.0, 0.0)
+            );
+        }
     }
 }

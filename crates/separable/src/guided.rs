@@ -292,3 +292,44 @@ pub fn optimize(kernel: &Kernel2d, opts: &GuidedOptions) -> Result<GuidedResult,
         support_mm: kernel.half_width_mm(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::constrained_update;
+
+    /// The projection against a worked example and against bisection on μ: aᵢ = max(0,
+    /// (Nᵢ + μ)/Dᵢ) with Σ aᵢ = sum.
+    #[test]
+    fn constrained_update_meets_the_sum_with_the_right_multiplier() {
+        // N = (3, 1, −2), D = 1, sum 3: with entries 0 and 1 active, 4 + 2μ = 3, μ = −1/2,
+        // a = (2.5, 0.5, 0) (entry 2 stays inactive: −2 − 1/2 < 0).
+        let mut out = [0.0; 3];
+        constrained_update(&[3.0, 1.0, -2.0], &[1.0; 3], 3.0, &mut out);
+        for (a, b) in out.iter().zip([2.5, 0.5, 0.0]) {
+            assert!((a - b).abs() < 1e-14, "{out:?}");
+        }
+        // Unequal D: μ by bisection on the non-decreasing g(μ) = Σ max(0, (Nᵢ + μ)/Dᵢ).
+        let (num, den, sum) = ([2.0, 1.0, 0.5, -0.3], [1.0, 2.0, 4.0, 0.5], 1.7);
+        let g = |mu: f64| -> f64 {
+            num.iter()
+                .zip(&den)
+                .map(|(n, d)| ((n + mu) / d).max(0.0))
+                .sum()
+        };
+        let (mut lo, mut hi) = (-10.0, 10.0);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if g(mid) < sum {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let mut out = [0.0; 4];
+        constrained_update(&num, &den, sum, &mut out);
+        for i in 0..4 {
+            let want = ((num[i] + lo) / den[i]).max(0.0);
+            assert!((out[i] - want).abs() < 1e-12, "{i}: {out:?} vs μ {lo}");
+        }
+    }
+}

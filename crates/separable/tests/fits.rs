@@ -182,3 +182,34 @@ fn the_artist_profile_is_a_normalised_two_gaussian_mix() {
         }
     }
 }
+
+/// Each term of a sum-of-Gaussians kernel is the 1D Gaussian of its own variance on both
+/// axes: with every grid cell a tap, the taps' second moment Σ w x² / Σ w is vᵢ (less the
+/// 0.11 % of a Gaussian's variance beyond ±4σ, where the grid stops) per channel.
+#[test]
+fn each_gaussian_term_has_its_variance() {
+    let m = common::model("skin1");
+    let fits = gaussians::fit_model(m.as_ref(), 4).unwrap();
+    let f = &fits[3];
+    let k = f.kernel([0.5, 0.4, 0.3], TapPlacement::Grid).unwrap();
+    assert_eq!(k.terms.len(), 4);
+    for (term, &v) in k.terms.iter().zip(&f.variances) {
+        for pass in [&term.horizontal, &term.vertical] {
+            for c in 0..3 {
+                let (mut m0, mut m2) = (0.0, 0.0);
+                for t in &pass.taps {
+                    m0 += t.weight[c];
+                    m2 += t.weight[c] * t.offset_mm * t.offset_mm;
+                }
+                if m0 == 0.0 {
+                    continue;
+                }
+                let got = m2 / m0;
+                assert!(
+                    (got / (v * 0.99889) - 1.0).abs() < 2e-3,
+                    "variance {v}: taps' second moment {got} (channel {c})"
+                );
+            }
+        }
+    }
+}

@@ -241,3 +241,42 @@ fn bad_input_is_an_error() {
         .is_err()
     );
 }
+
+/// The exact 2D reference's rule for signed kernels: where a silhouette drops cells, the
+/// dropped weight takes the centre's value, so a constant irradiance E comes out as E × the
+/// kernel's total on both sides of the silhouette. The kernel is a difference of Gaussians
+/// (a positive core, a negative ring: it changes sign, so the renormalising branch is not
+/// taken) in every channel.
+#[test]
+fn exact_reference_keeps_a_constant_under_a_signed_kernel_at_a_silhouette() {
+    let dog = |x: f64, y: f64| {
+        let r2 = x * x + y * y;
+        let g = |s: f64| (-r2 / (2.0 * s * s)).exp() / (2.0 * std::f64::consts::PI * s * s);
+        [1.5 * g(0.5) - 0.5 * g(1.5); 3]
+    };
+    let k = sss_separable::Kernel2d::from_density(21, 0.4, 4, dog).unwrap();
+    assert!(k.mass[0].iter().any(|m| *m < 0.0) && k.mass[0].iter().any(|m| *m > 0.0));
+    let mut f = Frame::flat(40, 12, 0.3);
+    for y in 0..f.height {
+        for x in 20..f.width {
+            f.mask[y * f.width + x] = 1;
+        }
+    }
+    let e = [1.0f32, 0.8, 0.5];
+    for p in f.irradiance.iter_mut() {
+        *p = e;
+    }
+    let out = convolve2d::exact(&f.input(), &k, &FilterOptions::default()).unwrap();
+    for y in 0..f.height {
+        for x in 0..f.width {
+            for c in 0..3 {
+                let want = e[c] as f64 * k.total[c];
+                let got = out[y * f.width + x][c] as f64;
+                assert!(
+                    (got - want).abs() < 1e-5 * want.abs(),
+                    "({x},{y}) ch {c}: {got} vs {want}"
+                );
+            }
+        }
+    }
+}
