@@ -1761,6 +1761,19 @@ mod tests {
         let back = McTableData::from_bytes(&bytes).unwrap();
         assert_eq!(back, data);
         assert_eq!(back.to_bytes(), bytes);
+        // Every table's rows hold their own walks: the total (all escaped weight) is at least
+        // the binned weight, and the tables differ.
+        for e in 0..ETAS.len() {
+            for i in 0..N_RHO {
+                let binned: f64 = data.mass(e, i).iter().sum();
+                let (total, _) = data.total(e, i);
+                assert!(
+                    total >= binned * (1.0 - 1e-6),
+                    "eta {e} row {i}: {total} < {binned}"
+                );
+            }
+        }
+        assert!((0..N_RHO).any(|i| data.total(0, i) != data.total(ETAS.len() - 1, i)));
         // Any damage is an error, never a panic.
         for at in [0, 9, 40, bytes.len() / 2, bytes.len() - 1] {
             let mut bad = bytes.clone();
