@@ -60,6 +60,11 @@ struct TablesArgs {
     /// Worker threads [default: all cores]; the table is the same for any number.
     #[arg(long)]
     threads: Option<usize>,
+    /// Take every table whose g, η and walks this file (version 1 or 2) holds unchanged from
+    /// it instead of running its walks again: the same bytes as a full run, since every walk
+    /// is seeded. Not with --check.
+    #[arg(long, conflicts_with = "check")]
+    reuse: Option<PathBuf>,
 }
 
 /// Arguments of `cargo xtask fuzz`.
@@ -210,6 +215,7 @@ fn main() -> ExitCode {
                     .unwrap_or_else(|| tables::default_path(&workspace_root())),
                 scale: args.scale,
                 check: args.check,
+                reuse: args.reuse,
             };
             let result = match args.threads {
                 Some(0) => Err("--threads must be at least 1".to_string()),

@@ -4,7 +4,8 @@
 //! Every walk has a fixed seed and stream and the Monte Carlo is bit-identical for any number
 //! of threads, so the file is the same bytes on every run. `--check` regenerates it and
 //! compares it with the file in the repository instead of writing it; `--scale` multiplies
-//! every photon count (for trial runs; the repository's table is `--scale 1`).
+//! every photon count (for trial runs; the repository's table is `--scale 1`); `--reuse FILE`
+//! copies the tables FILE holds with the same walks instead of running them again.
 
 use sss_bssrdf::mc_table::McTableData;
 use std::path::{Path, PathBuf};
@@ -19,6 +20,8 @@ pub struct Config {
     pub scale: f64,
     /// Compare with `out` instead of writing it.
     pub check: bool,
+    /// A table file (version 1 or 2) whose unchanged tables are copied instead of re-run.
+    pub reuse: Option<PathBuf>,
 }
 
 /// The repository's table file.
@@ -37,7 +40,18 @@ pub fn run(config: &Config) -> Result<(), String> {
         rayon::current_num_threads(),
         config.scale
     );
-    let data = McTableData::generate(config.scale, &|line| {
+    let reuse = match &config.reuse {
+        Some(path) => {
+            let bytes =
+                std::fs::read(path).map_err(|e| format!("reading {}: {e}", path.display()))?;
+            let data = McTableData::from_bytes(&bytes)
+                .or_else(|_| McTableData::from_bytes_v1(&bytes))
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            Some(data)
+        }
+        None => None,
+    };
+    let data = McTableData::generate_reusing(config.scale, reuse.as_ref(), &|line| {
         eprintln!("  [{:7.1} s] {line}", start.elapsed().as_secs_f64())
     })
     .map_err(|e| e.to_string())?;

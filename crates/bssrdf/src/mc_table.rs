@@ -1,5 +1,5 @@
 //! `mc-table`: the radial profile of the crate's own photon random walk ([`crate::monte_carlo`])
-//! tabulated once over single-scattering albedo, optical radius and relative index η, and
+//! tabulated once over albedo, optical radius, relative index η and anisotropy g, and
 //! evaluated and sampled like the photon beam diffusion table (pbrt 3rd ed. §11.4.2, §15.4.2:
 //! Catmull-Rom in albedo and radius, [`SplineRow`] rows pre-blended per channel), so a
 //! renderer gets the random walk's profile at the cost of a table lookup.
@@ -10,16 +10,24 @@
 //!   R_d(r) = σ_t² R_d¹(σ_t r), R_d¹ the unit-extinction profile (lengths scale by 1/σ_t; the
 //!   same scaling as pbrt Eq. 11.10 and [`crate::PhotonBeamDiffusion`]). The table stores
 //!   T(ρ, x) = 2πx R_d¹(x), as PBD's table does.
-//! - **Anisotropy.** The table has g = 0; a medium with g ≠ 0 is mapped by the similarity
-//!   relation to its reduced coefficients σ'_s = σ_s (1 − g), σ'_t = σ_a + σ'_s, ρ' = σ'_s/σ'_t
-//!   (Wyman, Patterson, Wilson, *Similarity relations for the interaction parameters in
-//!   radiation transport*, Appl. Opt. 28(24), 1989; Jensen et al. 2001 §2.4). This is exact for
-//!   the presets (Jensen et al. 2001 give σ'_s with g = 0) and an approximation otherwise,
-//!   measured against the walk with the true g: marble with g = 0.5 keeps its totals (within
-//!   0.2 %) but not the shape near the entry point (+24–29 % at 0.25 reduced mean free paths,
-//!   −6 to −11 % at 1–3); skin1 with g = 0.8 is off by +50–70 % at 0.25, −12 to −32 % at 1–4
-//!   and +1.4, +10, +25 % in its totals (red, green, blue). Photon beam diffusion, which
-//!   keeps g in its single scattering, is the better model for such media.
+//! - **Anisotropy.** One set of tables per g in [`GS`] (0, 0.2, 0.4, 0.7, 0.9), each in
+//!   *reduced* units: row ρ' is the reduced albedo σ'_s/σ'_t (σ'_s = σ_s (1 − g),
+//!   σ'_t = σ_a + σ'_s) and radii are in reduced mean free paths 1/σ'_t (for g = 0 these are the
+//!   units above). Every g then shares the rows and knots, the similarity relation (Wyman,
+//!   Patterson, Wilson, *Similarity relations for the interaction parameters in radiation
+//!   transport*, Appl. Opt. 28(24), 1989; Jensen et al. 2001 §2.4) is exact far from the
+//!   entry point, and what g changes — the profile near it, where similarity alone was off
+//!   by +24–29 % for marble with g = 0.5 and +50–70 % for skin1 with g = 0.8 at 0.25 reduced
+//!   mean free paths — is in the tables. The walk for g ≠ 0 still runs at unit extinction: row
+//!   ρ' is simulated at its single-scattering albedo ρ = ρ'/(1 − g + gρ')
+//!   ([`single_scattering_albedo`]) with the true g, and each escape is binned at σ'_t r =
+//!   (1 − ρg) r for that row (the per-row radius scales of the condensed walk, so the rows still
+//!   share their photons). Between the tables the knot values are blended linearly in g
+//!   (measured before the choice of grid: profiles move by at most a few per cent between
+//!   neighbouring g of this grid away from g = 0, where the near field changes fastest and the
+//!   0.2 step sits); a medium outside [0, 0.9] reads the nearest end table at its reduced
+//!   coefficients ([`McTableModel::g_in_range`] says so). Presets (Jensen et al. 2001 give σ'_s
+//!   with g = 0) read the g = 0 tables.
 //! - **Albedos.** [`N_RHO`] albedos on the grid of photon beam diffusion,
 //!   ρ_i = (1 − e^{−8i/99})/(1 − e^{−8}) (pbrt §15.5.5), dense near 1.
 //! - **Radii.** [`radius_knots`]: 0, then from 0.005 mean free paths steps of 20 % (geometric,
@@ -28,7 +36,7 @@
 //!   error on exponential tails small: a spline through e^{−σx} at spacing h is off by 0.8 %
 //!   mid-interval at σh = 0.75 and 2.5 % at σh = 1, and every ρ ≥ 0.5 decays at σ < 1 per mean
 //!   free path, while 20 % geometric steps would give σh > 3 at 16 mean free paths.
-//! - **η.** One table per η in [`ETAS`] (1.0 to 1.5 in steps of 0.1); between them the
+//! - **η.** One table per η in [`ETAS`] (1.0 to 1.5 in steps of 0.1) and g; between them the
 //!   profile is interpolated linearly in η (which keeps it non-negative and keeps ρ_eff
 //!   non-decreasing in ρ); the totals' curvature in η makes that < 0.3 % off at 0.1 spacing.
 //!   Outside [1.0, 1.5] the nearest end table is used: [`McTableModel::eta_in_range`] says
@@ -48,12 +56,13 @@
 //! origin and the poorly resolved far tail are pooled into resolved groups ([`inner_masses`],
 //! [`tail_masses`]); after it, R_d at the knots is made non-increasing by an isotonic fit
 //! ([`row_nodes`]), and the model makes the first interval [0, 0.1 x₁] linear in T
-//! ([`SplineRow::with_linear_first_segment`]). The spline then reproduces every tallied bin
+//! ([`SplineRow::with_linear_first_segment`]) and keeps the row it blends for a medium
+//! non-increasing in R_d (`monotone_row`). The spline then reproduces every tallied bin
 //! integral where the tallies are resolved and ordered, and its total stays within 3 standard
 //! errors of the tallied total reflectance for every albedo ≥ 0.5 (tested).
 //!
 //! # Generation
-//! [`McTableData::generate`] (run by `cargo xtask tables`) simulates every η and albedo band
+//! [`McTableData::generate`] (run by `cargo xtask tables`) simulates every g, η and albedo band
 //! with the condensed walk of [`crate::monte_carlo::condensed`] (one walk per band, every
 //! albedo row of the band tallied from the same photons) with fixed seeds, so the result is
 //! bit-identical for any thread count; [`McTableData::to_bytes`] writes it, and the crate
@@ -90,6 +99,30 @@ pub const MAIN_ETA: f64 = 1.3;
 
 /// Photons of the other η tables are those of [`MAIN_ETA`] divided by this.
 pub const OTHER_ETA_PHOTON_DIVISOR: u64 = 2;
+
+/// The Henyey-Greenstein anisotropies with tables of their own. The tables for g ≠ 0 are in
+/// reduced units (rows of reduced albedo ρ', radii in reduced mean free paths 1/σ'_t; see the
+/// module documentation), so at g = 0 they are the isotropic table and every g shares its
+/// rows and knots.
+pub const GS: [f64; 5] = [0.0, 0.2, 0.4, 0.7, 0.9];
+
+/// Photons of the tables for g ≠ 0 are those of g = 0 divided by this (their walks are
+/// longer: at the same reduced albedo the single-scattering albedo is closer to 1).
+pub const ANISOTROPIC_PHOTON_DIVISOR: u64 = 2;
+
+/// The single-scattering albedo ρ = ρ'/(1 − g + gρ') of a medium with reduced albedo ρ' and
+/// anisotropy g (inverting ρ' = ρ(1 − g)/(1 − ρg), the similarity relation of the module
+/// documentation); 0 for ρ' ≤ 0, 1 for ρ' ≥ 1.
+pub fn single_scattering_albedo(reduced: f64, g: f64) -> f64 {
+    if !(reduced > 0.0) {
+        return 0.0;
+    }
+    if reduced >= 1.0 {
+        return 1.0;
+    }
+    // 1 − g + gρ' ≥ min(1, 1 − g + g·0) > 0 for |g| < 1 and ρ' in (0, 1).
+    (reduced / (1.0 - g + g * reduced)).clamp(0.0, 1.0)
+}
 
 /// Master seed of every table walk.
 pub const SEED: u64 = 0x6d63_5f74_6162_6c65;
@@ -216,17 +249,22 @@ fn band_rows(rho: &[f64]) -> Vec<Range<usize>> {
     bands
 }
 
-/// The walks of the table of `ETAS[eta_index]`, with photon counts multiplied by `scale`
-/// (1 for the table in the repository; at least one photon per walk).
-pub fn plan(eta_index: usize, scale: f64) -> Vec<Walks> {
+/// The walks of the table of `GS[g_index]` and `ETAS[eta_index]`, with photon counts
+/// multiplied by `scale` (1 for the table in the repository; at least one photon per walk).
+/// The streams of the table of g = 0 and η index e start at e × (walks per table), as they
+/// did before the tables had g; table (g, e) starts at (g × [`ETAS`]`.len()` + e) × that.
+pub fn plan(g_index: usize, eta_index: usize, scale: f64) -> Vec<Walks> {
     let rho = rho_samples();
-    let divisor = if ETAS.get(eta_index) == Some(&MAIN_ETA) {
+    let mut divisor = if ETAS.get(eta_index) == Some(&MAIN_ETA) {
         1
     } else {
         OTHER_ETA_PHOTON_DIVISOR
     };
+    if g_index > 0 {
+        divisor *= ANISOTROPIC_PHOTON_DIVISOR;
+    }
     let per_eta: usize = BAND_STRATA.iter().map(|s| s.len()).sum();
-    let mut stream = eta_index * per_eta;
+    let mut stream = (g_index * ETAS.len() + eta_index) * per_eta;
     let mut walks = Vec::with_capacity(per_eta);
     for (rows, strata) in band_rows(&rho).into_iter().zip(BAND_STRATA) {
         let mut min_events = 1;
@@ -248,8 +286,11 @@ pub fn plan(eta_index: usize, scale: f64) -> Vec<Walks> {
 /// The table file embedded in the crate.
 const EMBEDDED: &[u8] = include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/mc_table.bin"));
 
-/// File magic of the table data (version 1).
-const MAGIC: &[u8; 8] = b"SSSMCT\x01\x00";
+/// File magic of the table data (version 2: tables over g and η).
+const MAGIC: &[u8; 8] = b"SSSMCT\x02\x00";
+
+/// File magic of version 1 (g = 0 only), read by [`McTableData::from_bytes_v1`].
+const MAGIC_V1: &[u8; 8] = b"SSSMCT\x01\x00";
 
 /// FNV-1a 64 (Fowler, Noll, Vo) of `bytes`: the checksum of the table file.
 fn fnv1a(bytes: &[u8]) -> u64 {
@@ -258,22 +299,27 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
-/// The Monte Carlo tallies behind the table: for every η of [`ETAS`] and albedo row, the
-/// escaped weight per photon in each bin of [`tally_edges`] (∫ 2πx R_d¹ dx over the bin, unit
-/// extinction, g = 0) with its standard error, and the row's total reflectance.
+/// The Monte Carlo tallies behind the table: for every table (g of [`GS`], η of [`ETAS`]) and
+/// albedo row, the escaped weight per photon in each bin of [`tally_edges`] (∫ 2πx R_d¹ dx
+/// over the bin; unit extinction for g = 0, unit reduced extinction otherwise) with its
+/// standard error, and the row's total reflectance.
+///
+/// The tables are numbered g-major: table `t = g_index × etas().len() + eta_index`
+/// ([`McTableData::table_index`]), so for g = 0 the table index is the η index.
 #[derive(Clone, Debug, PartialEq)]
 pub struct McTableData {
     seed: u64,
+    gs: Vec<f64>,
     etas: Vec<f64>,
     rho: Vec<f64>,
     knots: Vec<f64>,
     edges: Vec<f64>,
-    /// Per η, the walks.
+    /// Per table, the walks.
     walks: Vec<Vec<Walks>>,
-    /// Per (η, row, bin), row-major.
+    /// Per (table, row, bin), row-major.
     mass: Vec<f64>,
     mass_se: Vec<f64>,
-    /// Per (η, row).
+    /// Per (table, row).
     total: Vec<f64>,
     total_se: Vec<f64>,
     capped_weight: Vec<f64>,
@@ -281,9 +327,21 @@ pub struct McTableData {
 
 impl McTableData {
     /// Runs every walk of [`plan`] (photons × `scale`), calling `progress` with a line after
-    /// each. Takes ≈ 700 CPU-seconds at `scale` = 1 (measured on a shared 2-core machine).
+    /// each. Takes ≈ 700 CPU-seconds at `scale` = 1 for the tables of g = 0 (measured on a
+    /// shared 2-core machine) and about 4.5 times that for the others (see the README).
     /// Bit-identical for any number of rayon threads.
     pub fn generate(scale: f64, progress: &dyn Fn(&str)) -> Result<McTableData, BssrdfError> {
+        McTableData::generate_reusing(scale, None, progress)
+    }
+
+    /// [`McTableData::generate`], taking each table whose g, η, seed and walks `reuse` holds
+    /// unchanged from it instead of running its walks again (every walk is seeded, so the
+    /// result is the same as a full run; `cargo xtask tables --reuse`).
+    pub fn generate_reusing(
+        scale: f64,
+        reuse: Option<&McTableData>,
+        progress: &dyn Fn(&str),
+    ) -> Result<McTableData, BssrdfError> {
         if !(scale > 0.0 && scale.is_finite()) {
             return Err(BssrdfError::InvalidArgument(format!(
                 "mc-table: photon scale {scale} must be finite and > 0"
@@ -293,94 +351,170 @@ impl McTableData {
         let knots = radius_knots();
         let edges = tally_edges(&knots);
         let bins = edges.len() - 1;
-        let cells = ETAS.len() * N_RHO * bins;
+        let tables = GS.len() * ETAS.len();
+        let cells = tables * N_RHO * bins;
         let mut data = McTableData {
             seed: SEED,
+            gs: GS.to_vec(),
             etas: ETAS.to_vec(),
             rho: rho.clone(),
             knots,
             edges: edges.clone(),
             walks: Vec::new(),
             mass: vec![0.0; cells],
-            mass_se: Vec::new(),
-            total: vec![0.0; ETAS.len() * N_RHO],
-            total_se: vec![0.0; ETAS.len() * N_RHO],
-            capped_weight: vec![0.0; ETAS.len() * N_RHO],
+            mass_se: vec![0.0; cells],
+            total: vec![0.0; tables * N_RHO],
+            total_se: vec![0.0; tables * N_RHO],
+            capped_weight: vec![0.0; tables * N_RHO],
         };
-        // Strata of one band add up: sums of masses and totals, variances in quadrature.
-        let mut var = vec![0.0; cells];
-        let mut total_var = vec![0.0; ETAS.len() * N_RHO];
-        for (e, &eta) in ETAS.iter().enumerate() {
-            let walks = plan(e, scale);
-            for walk in &walks {
-                let start = std::time::Instant::now();
-                let profile = simulate_albedos(&CondensedConfig {
-                    photons: walk.photons,
-                    seed: SEED,
-                    stream: walk.stream,
-                    albedos: rho[walk.rows.clone()].to_vec(),
-                    g: 0.0,
-                    eta,
-                    edges: edges.clone(),
-                    min_events: walk.min_events,
-                    max_events: walk.max_events,
-                })?;
-                for (k, i) in walk.rows.clone().enumerate() {
-                    let cell = (e * N_RHO + i) * bins;
-                    for b in 0..bins {
-                        data.mass[cell + b] += profile.row_mass(k)[b];
-                        var[cell + b] += profile.row_mass_se(k)[b].powi(2);
+        for (gi, &g) in GS.iter().enumerate() {
+            for (e, &eta) in ETAS.iter().enumerate() {
+                let t = gi * ETAS.len() + e;
+                let walks = plan(gi, e, scale);
+                let old = reuse.and_then(|r| r.find_table(g, eta, SEED, &walks));
+                if let Some((r, rt)) = old {
+                    let (cell, row) = (t * N_RHO * bins, t * N_RHO);
+                    let (rcell, rrow) = (rt * N_RHO * bins, rt * N_RHO);
+                    let n = N_RHO * bins;
+                    data.mass[cell..cell + n].copy_from_slice(&r.mass[rcell..rcell + n]);
+                    data.mass_se[cell..cell + n].copy_from_slice(&r.mass_se[rcell..rcell + n]);
+                    for (dst, src) in [
+                        (&mut data.total, &r.total),
+                        (&mut data.total_se, &r.total_se),
+                        (&mut data.capped_weight, &r.capped_weight),
+                    ] {
+                        dst[row..row + N_RHO].copy_from_slice(&src[rrow..rrow + N_RHO]);
                     }
-                    data.total[e * N_RHO + i] += profile.total[k];
-                    total_var[e * N_RHO + i] += profile.total_se[k].powi(2);
-                    if walk.max_events == MAX_SCATTERING_EVENTS {
-                        data.capped_weight[e * N_RHO + i] = profile.capped_weight[k];
-                    }
-                }
-                let stopped = if walk.max_events == MAX_SCATTERING_EVENTS {
-                    format!("{} stopped by the collision cap", profile.capped)
+                    progress(&format!("g {g}, eta {eta}: reused"));
                 } else {
-                    format!("{} walk on past the stratum", profile.capped)
-                };
-                progress(&format!(
-                    "eta {eta}: albedo rows {}..{} (rho {:.6}..{:.6}), collisions {}..={}, {} \
-                     photons, {:.1} s, {stopped}",
-                    walk.rows.start,
-                    walk.rows.end,
-                    rho[walk.rows.start],
-                    rho[walk.rows.end - 1],
-                    walk.min_events,
-                    walk.max_events,
-                    walk.photons,
-                    start.elapsed().as_secs_f64(),
-                ));
+                    data.simulate_table(t, g, eta, &walks, progress)?;
+                }
+                data.walks.push(walks);
             }
-            data.walks.push(walks);
         }
-        // Stored as f32 (see the module documentation).
-        for m in data.mass.iter_mut() {
-            *m = *m as f32 as f64;
-        }
-        data.mass_se = var.iter().map(|v| v.sqrt() as f32 as f64).collect();
-        data.total_se = total_var.iter().map(|v| v.sqrt()).collect();
         Ok(data)
     }
 
-    /// The binary file (little-endian): magic, seed, sizes, the grids (η, ρ, knots, edges),
-    /// the walks (rows, stream, collision range, photons), per (η, row) the total, its standard error and the capped
-    /// weight as f64, per (η, row, bin) the masses and then their standard errors as f32, and
-    /// the FNV-1a 64 of everything before it.
+    /// Runs the walks of table `t` (anisotropy `g`, index `eta`) into its cells.
+    fn simulate_table(
+        &mut self,
+        t: usize,
+        g: f64,
+        eta: f64,
+        walks: &[Walks],
+        progress: &dyn Fn(&str),
+    ) -> Result<(), BssrdfError> {
+        let bins = self.edges.len() - 1;
+        // Strata of one band add up: sums of masses and totals, variances in quadrature.
+        let mut var = vec![0.0; N_RHO * bins];
+        let mut total_var = vec![0.0; N_RHO];
+        for walk in walks {
+            let start = std::time::Instant::now();
+            let reduced = &self.rho[walk.rows.clone()];
+            // The rows are reduced albedos; the walk runs at their single-scattering albedos
+            // in a medium of unit extinction and bins row i at σ'_t r, σ'_t = 1 − ρ_i g.
+            let albedos: Vec<f64> = reduced
+                .iter()
+                .map(|&r| single_scattering_albedo(r, g))
+                .collect();
+            let radius_scales = if g == 0.0 {
+                Vec::new()
+            } else {
+                albedos.iter().map(|&a| 1.0 - a * g).collect()
+            };
+            let profile = simulate_albedos(&CondensedConfig {
+                photons: walk.photons,
+                seed: self.seed,
+                stream: walk.stream,
+                albedos,
+                g,
+                eta,
+                edges: self.edges.clone(),
+                min_events: walk.min_events,
+                max_events: walk.max_events,
+                radius_scales,
+            })?;
+            for (k, i) in walk.rows.clone().enumerate() {
+                let (cell, row) = ((t * N_RHO + i) * bins, t * N_RHO + i);
+                for b in 0..bins {
+                    self.mass[cell + b] += profile.row_mass(k)[b];
+                    var[i * bins + b] += profile.row_mass_se(k)[b].powi(2);
+                }
+                self.total[row] += profile.total[k];
+                total_var[i] += profile.total_se[k].powi(2);
+                if walk.max_events == MAX_SCATTERING_EVENTS {
+                    self.capped_weight[row] = profile.capped_weight[k];
+                }
+            }
+            let stopped = if walk.max_events == MAX_SCATTERING_EVENTS {
+                format!("{} stopped by the collision cap", profile.capped)
+            } else {
+                format!("{} walk on past the stratum", profile.capped)
+            };
+            progress(&format!(
+                "g {g}, eta {eta}: albedo rows {}..{} (rho' {:.6}..{:.6}), collisions {}..={}, \
+                 {} photons, {:.1} s, {stopped}",
+                walk.rows.start,
+                walk.rows.end,
+                self.rho[walk.rows.start],
+                self.rho[walk.rows.end - 1],
+                walk.min_events,
+                walk.max_events,
+                walk.photons,
+                start.elapsed().as_secs_f64(),
+            ));
+        }
+        // Stored as f32 (see the module documentation).
+        let (cells, rows) = (t * N_RHO * bins, t * N_RHO);
+        for (k, v) in var.iter().enumerate() {
+            let m = &mut self.mass[cells + k];
+            *m = *m as f32 as f64;
+            self.mass_se[cells + k] = v.sqrt() as f32 as f64;
+        }
+        for (i, v) in total_var.iter().enumerate() {
+            self.total_se[rows + i] = v.sqrt();
+        }
+        Ok(())
+    }
+
+    /// The table of anisotropy `g` and index `eta`, if this data holds it with the same seed
+    /// and walks: (self, its table index).
+    fn find_table(&self, g: f64, eta: f64, seed: u64, walks: &[Walks]) -> Option<(&Self, usize)> {
+        if self.seed != seed || self.rho != rho_samples() || self.knots != radius_knots() {
+            return None;
+        }
+        let gi = self.gs.iter().position(|&x| x.to_bits() == g.to_bits())?;
+        let e = self
+            .etas
+            .iter()
+            .position(|&x| x.to_bits() == eta.to_bits())?;
+        let t = gi * self.etas.len() + e;
+        (self.walks.get(t)?.as_slice() == walks).then_some((self, t))
+    }
+
+    /// The binary file (little-endian): magic, seed, sizes (g, η, ρ, knots, walks per table),
+    /// the grids (g, η, ρ, knots, edges), per table the walks (rows, stream, collision range,
+    /// photons), per (table, row) the total, its standard error and the capped weight as f64,
+    /// per (table, row, bin) the masses and then their standard errors as f32, and the FNV-1a
+    /// 64 of everything before it.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::new();
         out.extend_from_slice(MAGIC);
         out.extend_from_slice(&self.seed.to_le_bytes());
         let n_walks = self.walks.first().map_or(0, Vec::len);
-        for n in [self.etas.len(), self.rho.len(), self.knots.len(), n_walks] {
+        for n in [
+            self.gs.len(),
+            self.etas.len(),
+            self.rho.len(),
+            self.knots.len(),
+            n_walks,
+        ] {
             out.extend_from_slice(&(n as u32).to_le_bytes());
         }
         for v in self
-            .etas
+            .gs
             .iter()
+            .chain(&self.etas)
             .chain(&self.rho)
             .chain(&self.knots)
             .chain(&self.edges)
@@ -411,15 +545,36 @@ impl McTableData {
     }
 
     /// Reads [`McTableData::to_bytes`]'s format. Errors (never panics) on a wrong magic or
-    /// checksum, a truncated file, grids other than this version's ([`ETAS`],
+    /// checksum, a truncated file, grids other than this version's ([`GS`], [`ETAS`],
     /// [`rho_samples`], [`radius_knots`]) or values that are not finite and ≥ 0.
     pub fn from_bytes(bytes: &[u8]) -> Result<McTableData, BssrdfError> {
+        let data = McTableData::parse(bytes, MAGIC)?;
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        if bits(&data.gs) != bits(&GS) || bits(&data.etas) != bits(&ETAS) {
+            return Err(BssrdfError::InvalidArgument(
+                "mc-table data: grids differ from this version's (regenerate with `cargo xtask \
+                 tables`)"
+                    .into(),
+            ));
+        }
+        Ok(data)
+    }
+
+    /// Reads a version-1 file (the tables of g = 0 only, before the tables had g), as data
+    /// with `gs() == [0.0]`: something to [`McTableData::generate_reusing`] from, not a table
+    /// the model reads.
+    pub fn from_bytes_v1(bytes: &[u8]) -> Result<McTableData, BssrdfError> {
+        McTableData::parse(bytes, MAGIC_V1)
+    }
+
+    /// The common reader of both versions (version 1 has no g grid: it is g = 0).
+    fn parse(bytes: &[u8], magic: &[u8; 8]) -> Result<McTableData, BssrdfError> {
         let bad = |what: &str| {
             Err(BssrdfError::InvalidArgument(format!(
                 "mc-table data: {what}"
             )))
         };
-        if bytes.len() < MAGIC.len() + 8 || &bytes[..MAGIC.len()] != MAGIC {
+        if bytes.len() < magic.len() + 8 || &bytes[..magic.len()] != magic {
             return bad("not a table file of this version (magic)");
         }
         let (body, sum) = bytes.split_at(bytes.len() - 8);
@@ -428,26 +583,31 @@ impl McTableData {
         }
         let mut r = Reader {
             bytes: body,
-            at: MAGIC.len(),
+            at: magic.len(),
         };
+        let v1 = magic == MAGIC_V1;
         let seed = r.u64()?;
+        let n_g = if v1 { 1 } else { r.u32()? as usize };
         let sizes = [r.u32()?, r.u32()?, r.u32()?, r.u32()?].map(|v| v as usize);
         let [n_eta, n_rho, n_knots, n_walks] = sizes;
+        let gs = if v1 { vec![0.0] } else { r.f64s(n_g)? };
         let etas = r.f64s(n_eta)?;
         let rho = r.f64s(n_rho)?;
         let knots = r.f64s(n_knots)?;
         let edges = r.f64s(n_knots.saturating_add(1))?;
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
         let want_knots = radius_knots();
-        if bits(&etas) != bits(&ETAS)
-            || bits(&rho) != bits(&rho_samples())
+        if bits(&rho) != bits(&rho_samples())
             || bits(&knots) != bits(&want_knots)
             || bits(&edges) != bits(&tally_edges(&want_knots))
+            || n_g == 0
+            || n_eta == 0
         {
             return bad("grids differ from this version's (regenerate with `cargo xtask tables`)");
         }
-        let mut walks = Vec::with_capacity(n_eta);
-        for _ in 0..n_eta {
+        let tables = n_g.saturating_mul(n_eta);
+        let mut walks = Vec::with_capacity(tables.min(64));
+        for _ in 0..tables {
             let mut row = Vec::with_capacity(n_walks.min(64));
             for _ in 0..n_walks {
                 let (start, end, stream) = (r.u32()? as usize, r.u32()? as usize, r.u32()?);
@@ -465,7 +625,7 @@ impl McTableData {
             }
             walks.push(row);
         }
-        let rows = n_eta.saturating_mul(n_rho);
+        let rows = tables.saturating_mul(n_rho);
         let (mut total, mut total_se, mut capped_weight) = (
             Vec::with_capacity(rows.min(1 << 16)),
             Vec::with_capacity(rows.min(1 << 16)),
@@ -487,12 +647,14 @@ impl McTableData {
             && valid(&mass_se)
             && valid(&total)
             && valid(&total_se)
-            && valid(&capped_weight))
+            && valid(&capped_weight)
+            && gs.iter().all(|g| g.abs() < 1.0))
         {
             return bad("a tallied value is negative or not finite");
         }
         Ok(McTableData {
             seed,
+            gs,
             etas,
             rho,
             knots,
@@ -519,12 +681,24 @@ impl McTableData {
         self.seed
     }
 
+    /// The anisotropy of each table ([`GS`]).
+    pub fn gs(&self) -> &[f64] {
+        &self.gs
+    }
+
     /// The η of each table ([`ETAS`]).
     pub fn etas(&self) -> &[f64] {
         &self.etas
     }
 
-    /// The albedo rows ([`rho_samples`]).
+    /// The index of the table of `gs()[g_index]` and `etas()[eta_index]`, the `t` of the
+    /// accessors below.
+    pub fn table_index(&self, g_index: usize, eta_index: usize) -> usize {
+        g_index * self.etas.len() + eta_index
+    }
+
+    /// The albedo rows ([`rho_samples`]): single-scattering albedos for g = 0, reduced
+    /// albedos otherwise.
     pub fn rho_samples(&self) -> &[f64] {
         &self.rho
     }
@@ -539,37 +713,37 @@ impl McTableData {
         &self.edges
     }
 
-    /// The walks of the table of η index `e`.
-    pub fn walks(&self, e: usize) -> &[Walks] {
-        &self.walks[e]
+    /// The walks of table `t`.
+    pub fn walks(&self, t: usize) -> &[Walks] {
+        &self.walks[t]
     }
 
-    fn cell(&self, e: usize, i: usize) -> Range<usize> {
+    fn cell(&self, t: usize, i: usize) -> Range<usize> {
         let bins = self.knots.len();
-        let start = (e * self.rho.len() + i) * bins;
+        let start = (t * self.rho.len() + i) * bins;
         start..start + bins
     }
 
-    /// The tallied bin masses ∫ 2πx R_d¹ dx of η index `e`, albedo row `i`.
-    pub fn mass(&self, e: usize, i: usize) -> &[f64] {
-        &self.mass[self.cell(e, i)]
+    /// The tallied bin masses ∫ 2πx R_d¹ dx of table `t`, albedo row `i`.
+    pub fn mass(&self, t: usize, i: usize) -> &[f64] {
+        &self.mass[self.cell(t, i)]
     }
 
     /// Standard errors of [`McTableData::mass`].
-    pub fn mass_se(&self, e: usize, i: usize) -> &[f64] {
-        &self.mass_se[self.cell(e, i)]
+    pub fn mass_se(&self, t: usize, i: usize) -> &[f64] {
+        &self.mass_se[self.cell(t, i)]
     }
 
-    /// The tallied total reflectance (all radii) of η index `e`, albedo row `i`, and its
+    /// The tallied total reflectance (all radii) of table `t`, albedo row `i`, and its
     /// standard error.
-    pub fn total(&self, e: usize, i: usize) -> (f64, f64) {
-        let k = e * self.rho.len() + i;
+    pub fn total(&self, t: usize, i: usize) -> (f64, f64) {
+        let k = t * self.rho.len() + i;
         (self.total[k], self.total_se[k])
     }
 
-    /// The weight per photon lost to the event cap of the walk (η index `e`, row `i`).
-    pub fn capped_weight(&self, e: usize, i: usize) -> f64 {
-        self.capped_weight[e * self.rho.len() + i]
+    /// The weight per photon lost to the event cap of the walk (table `t`, row `i`).
+    pub fn capped_weight(&self, t: usize, i: usize) -> f64 {
+        self.capped_weight[t * self.rho.len() + i]
     }
 }
 
@@ -1128,7 +1302,7 @@ pub fn row_nodes(system: &Histopolation, knots: &[f64], mass: &[f64], se: &[f64]
     out
 }
 
-/// The knot values of every albedo row of η index `e` ([`row_nodes`]). Row-major [`N_RHO`] ×
+/// The knot values of every albedo row of table `e` ([`row_nodes`]). Row-major [`N_RHO`] ×
 /// knots.
 fn node_values(data: &McTableData, e: usize) -> Vec<f64> {
     let knots = data.knots();
@@ -1145,27 +1319,62 @@ fn node_values(data: &McTableData, e: usize) -> Vec<f64> {
     out
 }
 
-/// Per η of [`ETAS`], the knot values of the embedded data (computed once).
-fn embedded_nodes() -> Option<&'static [Vec<f64>]> {
-    static NODES: OnceLock<Option<Vec<Vec<f64>>>> = OnceLock::new();
+/// Per table of the embedded data (g-major over [`GS`] × [`ETAS`]), its knot values, each
+/// computed on first use (a medium with g = 0 never solves the tables of g ≠ 0).
+fn embedded_nodes(t: usize) -> Option<&'static [f64]> {
+    const TABLES: usize = GS.len() * ETAS.len();
+    static NODES: [OnceLock<Option<Vec<f64>>>; TABLES] = [const { OnceLock::new() }; TABLES];
     NODES
-        .get_or_init(|| {
-            let data = McTableData::embedded().ok()?;
-            Some(
-                (0..data.etas().len())
-                    .map(|e| node_values(data, e))
-                    .collect(),
-            )
-        })
+        .get(t)?
+        .get_or_init(|| Some(node_values(McTableData::embedded().ok()?, t)))
         .as_deref()
 }
 
-/// The tabulated Monte Carlo profile for one η (the counterpart of
+/// `(1 − t) a + t b` per value, exactly `a` at t = 0 and `b` at t = 1 (empty unless both have
+/// `len` values).
+fn blend_nodes(a: &[f64], b: &[f64], t: f64, len: usize) -> Vec<f64> {
+    if a.len() != len || b.len() != len {
+        return Vec::new();
+    }
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| {
+            if t == 0.0 {
+                *a
+            } else if t == 1.0 {
+                *b
+            } else {
+                (1.0 - t) * a + t * b
+            }
+        })
+        .collect()
+}
+
+/// The knot values at (`eta`, `g`), both already clamped: the four tables around them blended
+/// bilinearly (linear in η, then in g), through `nodes(t)` for table t.
+fn blended_nodes<'a>(eta: f64, g: f64, nodes: impl Fn(usize) -> Option<&'a [f64]>) -> Vec<f64> {
+    let len = N_RHO * (radius_knots().len() + 1);
+    let (e0, e1, te) = eta_bracket(eta);
+    let (g0, g1, tg) = g_bracket(g);
+    let at = |gi: usize| {
+        let (a, b) = (nodes(gi * ETAS.len() + e0), nodes(gi * ETAS.len() + e1));
+        blend_nodes(a.unwrap_or(&[]), b.unwrap_or(&[]), te, len)
+    };
+    if tg == 0.0 {
+        at(g0)
+    } else {
+        blend_nodes(&at(g0), &at(g1), tg, len)
+    }
+}
+
+/// The tabulated Monte Carlo profile for one η and g (the counterpart of
 /// [`crate::photon_beam_diffusion::PbdTable`]): [`N_RHO`] albedo rows × [`radius_knots`] of
-/// T(ρ, x) = 2πx R_d¹(x) (unit extinction, g = 0), their running integrals and totals.
+/// T(ρ', x') = 2πx' R_d¹(x') (reduced albedo and radius in reduced mean free paths; for g = 0
+/// these are ρ and σ_t r), their running integrals and totals.
 #[derive(Clone, Debug)]
 pub struct McTable {
     eta: f64,
+    g: f64,
     rho_samples: Vec<f64>,
     radius_samples: Vec<f64>,
     /// Row-major N_RHO × knots values of T.
@@ -1178,24 +1387,44 @@ pub struct McTable {
 }
 
 impl McTable {
-    /// The table for `eta` from the embedded data: η clamped to [1.0, 1.5], then the knot
-    /// values of the two neighbouring tables of [`ETAS`] blended linearly in η. If the
-    /// embedded data could not be read (see [`McTableData::embedded`]) the table is all zeros.
+    /// The isotropic (g = 0) table for `eta`: [`McTable::anisotropic`] at g = 0.
     pub fn new(eta: f64) -> McTable {
-        let eta = clamp_eta(eta);
-        let (lo, hi, t) = eta_bracket(eta);
-        match embedded_nodes() {
-            Some(nodes) => McTable::from_nodes(eta, &nodes[lo], &nodes[hi], t),
-            None => McTable::from_nodes(eta, &[], &[], t),
-        }
+        McTable::anisotropic(eta, 0.0)
     }
 
-    /// [`McTable::new`] from `data` without any cache: the spline knot values of the two η
+    /// The table for `eta` and `g` from the embedded data: η clamped to [1.0, 1.5] and g to
+    /// [0, 0.9] ([`GS`]), then the knot values of the four neighbouring tables blended
+    /// bilinearly (linear in η, then in g). If the embedded data could not be read (see
+    /// [`McTableData::embedded`]) the table is all zeros.
+    pub fn anisotropic(eta: f64, g: f64) -> McTable {
+        let (eta, g) = (clamp_eta(eta), clamp_g(g));
+        McTable::from_nodes(eta, g, &blended_nodes(eta, g, embedded_nodes))
+    }
+
+    /// The isotropic table from `data` without any cache: the spline knot values of the two η
     /// tables are solved from the tallies here (what the first model of a process pays).
     pub fn from_data(data: &McTableData, eta: f64) -> McTable {
-        let eta = clamp_eta(eta);
-        let (lo, hi, t) = eta_bracket(eta);
-        McTable::from_nodes(eta, &node_values(data, lo), &node_values(data, hi), t)
+        McTable::from_data_anisotropic(data, eta, 0.0)
+    }
+
+    /// [`McTable::anisotropic`] from `data` (which must hold the tables of [`GS`] × [`ETAS`];
+    /// all zeros otherwise), without any cache.
+    pub fn from_data_anisotropic(data: &McTableData, eta: f64, g: f64) -> McTable {
+        let (eta, g) = (clamp_eta(eta), clamp_g(g));
+        let full = data.gs().len() == GS.len() && data.etas().len() == ETAS.len();
+        let ((e0, e1, _), (g0, g1, _)) = (eta_bracket(eta), g_bracket(g));
+        let needed = |t: usize| {
+            let (gi, e) = (t / ETAS.len(), t % ETAS.len());
+            (gi == g0 || gi == g1) && (e == e0 || e == e1)
+        };
+        let solved: Vec<Option<Vec<f64>>> = (0..GS.len() * ETAS.len())
+            .map(|t| (full && needed(t)).then(|| node_values(data, t)))
+            .collect();
+        McTable::from_nodes(
+            eta,
+            g,
+            &blended_nodes(eta, g, |t| solved.get(t)?.as_deref()),
+        )
     }
 
     /// [`McTable::from_data`] of the embedded file, parsed again (a cold start: what the first
@@ -1203,27 +1432,18 @@ impl McTable {
     pub fn from_embedded_uncached(eta: f64) -> McTable {
         match McTableData::from_bytes(EMBEDDED) {
             Ok(data) => McTable::from_data(&data, eta),
-            Err(_) => McTable::from_nodes(clamp_eta(eta), &[], &[], 0.0),
+            Err(_) => McTable::from_nodes(clamp_eta(eta), 0.0, &[]),
         }
     }
 
-    /// The table through knot values `(1 − t) a + t b` (all zeros when `a` or `b` is not a
-    /// full table).
-    fn from_nodes(eta: f64, a: &[f64], b: &[f64], t: f64) -> McTable {
+    /// The table through the knot values `nodes` (all zeros when it is not a full table).
+    fn from_nodes(eta: f64, g: f64, nodes: &[f64]) -> McTable {
         let rho_samples = rho_samples();
         let radius_samples = spline_knots(&radius_knots());
         let n = radius_samples.len();
         let mut profile = vec![0.0; N_RHO * n];
-        if a.len() == profile.len() && b.len() == profile.len() {
-            for (p, (a, b)) in profile.iter_mut().zip(a.iter().zip(b)) {
-                *p = if t == 0.0 {
-                    *a
-                } else if t == 1.0 {
-                    *b
-                } else {
-                    (1.0 - t) * a + t * b
-                };
-            }
+        if nodes.len() == profile.len() {
+            profile.copy_from_slice(nodes);
         }
         let mut profile_cdf = Vec::with_capacity(profile.len());
         let mut rho_eff = Vec::with_capacity(N_RHO);
@@ -1235,6 +1455,7 @@ impl McTable {
         let index = KnotIndex::new(&radius_samples).expect("the radius knots are increasing");
         McTable {
             eta,
+            g,
             rho_samples,
             radius_samples,
             profile,
@@ -1244,17 +1465,17 @@ impl McTable {
         }
     }
 
-    /// The table for `eta` from a process-wide cache keyed by the clamped η's bits, built on
-    /// first use. Every call with the same η returns the same `Arc`.
-    pub fn shared(eta: f64) -> Arc<McTable> {
-        type Cache = Mutex<HashMap<u64, Arc<McTable>>>;
+    /// The table for `eta` and `g` from a process-wide cache keyed by the clamped values'
+    /// bits, built on first use. Every call with the same η and g returns the same `Arc`.
+    pub fn shared(eta: f64, g: f64) -> Arc<McTable> {
+        type Cache = Mutex<HashMap<(u64, u64), Arc<McTable>>>;
         static CACHE: OnceLock<Cache> = OnceLock::new();
         let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-        let key = clamp_eta(eta).to_bits();
+        let key = (clamp_eta(eta).to_bits(), clamp_g(g).to_bits());
         if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
             return Arc::clone(t);
         }
-        let table = Arc::new(McTable::new(eta));
+        let table = Arc::new(McTable::anisotropic(eta, g));
         let mut map = cache.lock().unwrap_or_else(|e| e.into_inner());
         Arc::clone(map.entry(key).or_insert(table))
     }
@@ -1262,6 +1483,11 @@ impl McTable {
     /// The η of the table (clamped to [`ETAS`]' range).
     pub fn eta(&self) -> f64 {
         self.eta
+    }
+
+    /// The g of the table (clamped to [`GS`]' range).
+    pub fn g(&self) -> f64 {
+        self.g
     }
 
     /// The albedo rows ρ_i.
@@ -1358,11 +1584,35 @@ pub fn eta_in_range(eta: f64) -> bool {
     (ETAS[0]..=ETAS[ETAS.len() - 1]).contains(&eta)
 }
 
+/// The two tables of [`GS`] around `g` (already clamped) and the weight of the upper one.
+fn g_bracket(g: f64) -> (usize, usize, f64) {
+    let hi = GS.partition_point(|&x| x <= g).clamp(1, GS.len() - 1);
+    let (g0, g1) = (GS[hi - 1], GS[hi]);
+    (hi - 1, hi, ((g - g0) / (g1 - g0)).clamp(0.0, 1.0))
+}
+
+/// g clamped to the range of [`GS`] (NaN to 0).
+fn clamp_g(g: f64) -> f64 {
+    if g.is_nan() {
+        0.0
+    } else {
+        g.clamp(GS[0], GS[GS.len() - 1])
+    }
+}
+
+/// True when `g` lies in the range of [`GS`], where the tables are interpolated; a medium
+/// outside it (g < 0, or g > 0.9) reads the nearest end table at its reduced albedo and radius
+/// (the similarity relation: an approximation near the entry point, see the module
+/// documentation).
+pub fn g_in_range(g: f64) -> bool {
+    (GS[0]..=GS[GS.len() - 1]).contains(&g)
+}
+
 /// The `mc-table` model for one [`Medium`]: the random walk's profile from the shared
-/// [`McTable`] of its η, scaled to its reduced extinction.
+/// [`McTable`] of its η and g, scaled to its reduced extinction.
 ///
-/// - With σ'_t = σ_a + σ_s(1 − g) and ρ' = σ_s(1 − g)/σ'_t (the similarity relation, see the
-///   module documentation), [`Bssrdf::rd`] is σ'_t² times the table row blended at ρ',
+/// - With σ'_t = σ_a + σ_s(1 − g) and ρ' = σ_s(1 − g)/σ'_t (the tables' reduced units, see
+///   the module documentation), [`Bssrdf::rd`] is σ'_t² times the table row blended at ρ',
 ///   evaluated at x = rσ'_t and divided by 2πx, clamped to ≥ 0, and 0 beyond the table's
 ///   last knot. The row's first interval [0, 0.0005] is linear in 2πx R_d
 ///   ([`SplineRow::with_linear_first_segment`]): R_d is constant there instead of bumping.
@@ -1383,7 +1633,7 @@ pub struct McTableModel {
 impl McTableModel {
     /// The model for `medium`, sharing the table of its η with every other medium.
     pub fn new(medium: Medium) -> Self {
-        let table = McTable::shared(medium.eta());
+        let table = McTable::shared(medium.eta(), medium.g());
         let sigma_t: Rgb = std::array::from_fn(|ch| medium.sigma_t_reduced(ch));
         let rho: Rgb = std::array::from_fn(|ch| {
             let st = sigma_t[ch];
@@ -1395,14 +1645,7 @@ impl McTableModel {
             }
         });
         let rows = std::array::from_fn(|ch| {
-            SplineRow::blend(
-                &table.index,
-                &table.rho_samples,
-                &table.profile,
-                &table.profile_cdf,
-                rho[ch],
-            )
-            .map(|row| row.with_linear_first_segment())
+            monotone_row(&table, rho[ch]).map(|row| row.with_linear_first_segment())
         });
         McTableModel {
             medium,
@@ -1439,6 +1682,41 @@ impl McTableModel {
     pub fn eta_in_range(&self) -> bool {
         eta_in_range(self.medium.eta())
     }
+
+    /// True when the medium's g lies in [0, 0.9], the range of [`GS`]; otherwise the nearest
+    /// end table was read at the reduced albedo (see [`g_in_range`]).
+    pub fn g_in_range(&self) -> bool {
+        g_in_range(self.medium.g())
+    }
+}
+
+/// The table's row at reduced albedo `rho`, with R_d non-increasing: the knot values blended
+/// with the Catmull-Rom weights of `rho` over the albedo rows (as [`SplineRow::blend`]),
+/// clamped to ≥ 0 and made non-increasing in R_d ∝ T/x at the knots by a running minimum,
+/// then every segment on which R_d would still rise made straight
+/// ([`SplineRow::monotone_over_x`]). Every row is non-increasing at its knots on its own
+/// ([`row_nodes`]), but the Catmull-Rom weights go negative and its segments overshoot after
+/// flat stretches: where neighbouring rows' far tails differ (poorly resolved tails near
+/// ρ' → 1, mostly in the tables of g ≠ 0) R_d rose by up to 30 % at 10⁻⁸ of its peak, more
+/// than the many-light profile check accepts. `None` outside the rows.
+fn monotone_row(table: &McTable, rho: f64) -> Option<SplineRow> {
+    let (offset, w) = catmull_rom_weights(&table.rho_samples, rho)?;
+    let xs = &table.radius_samples;
+    let n = xs.len();
+    let mut values: Vec<f64> = (0..n)
+        .map(|k| apply_weights(offset, &w, |i| table.profile[i * n + k]).max(0.0))
+        .collect();
+    let mut least = f64::INFINITY;
+    for (v, &x) in values.iter_mut().zip(xs).skip(1) {
+        // x > 0 past the first knot (the knots increase from 0).
+        let r = *v / x;
+        if r > least {
+            *v = least * x;
+        } else {
+            least = r;
+        }
+    }
+    Some(SplineRow::new(&table.index, &values).monotone_over_x())
 }
 
 impl Bssrdf for McTableModel {
@@ -1534,8 +1812,8 @@ mod tests {
             assert!(edges[k] < x[k] && x[k] < edges[k + 1] || k == x.len() - 1);
         }
         // Bands cover every row once; each η has its own streams.
-        let p13 = plan(3, 1.0);
-        let p10 = plan(0, 1.0);
+        let p13 = plan(0, 3, 1.0);
+        let p10 = plan(0, 0, 1.0);
         let mut covered = vec![0; N_RHO];
         for w in p13.iter().filter(|w| w.min_events == 1) {
             for i in w.rows.clone() {
@@ -1549,6 +1827,32 @@ mod tests {
                 .zip(&p10)
                 .all(|(a, b)| a.photons == OTHER_ETA_PHOTON_DIVISOR * b.photons)
         );
+        // Every table of every g has its own streams; g ≠ 0 has half the photons.
+        let mut streams: Vec<usize> = (0..GS.len())
+            .flat_map(|g| (0..ETAS.len()).flat_map(move |e| plan(g, e, 1.0)))
+            .map(|w| w.stream)
+            .collect();
+        let n = streams.len();
+        streams.sort_unstable();
+        streams.dedup();
+        assert_eq!(streams.len(), n);
+        for g in 1..GS.len() {
+            let pg = plan(g, 3, 1.0);
+            assert!(pg.iter().zip(&p13).all(|(a, b)| {
+                a.rows == b.rows && ANISOTROPIC_PHOTON_DIVISOR * a.photons == b.photons
+            }));
+        }
+        // ρ' ↦ ρ inverts the similarity relation ρ' = ρ(1 − g)/(1 − ρg).
+        for g in [-0.5, 0.0, 0.4, 0.9] {
+            for rp in [0.0, 0.1, 0.5, 0.9, 0.999, 1.0] {
+                let rho = single_scattering_albedo(rp, g);
+                let back = rho * (1.0 - g) / (1.0 - rho * g);
+                assert!(
+                    (back - rp).abs() < 1e-14,
+                    "g {g} rho' {rp}: {rho} -> {back}"
+                );
+            }
+        }
     }
 
     #[test]
@@ -1761,19 +2065,30 @@ mod tests {
         let back = McTableData::from_bytes(&bytes).unwrap();
         assert_eq!(back, data);
         assert_eq!(back.to_bytes(), bytes);
+        assert_eq!(data.gs(), GS);
+        // Reusing a run's tables gives its bytes; tables whose walks differ (another scale)
+        // are run again, as without reuse.
+        let reused = McTableData::generate_reusing(2e-5, Some(&data), &quiet).unwrap();
+        assert_eq!(reused.to_bytes(), bytes);
+        let other_scale = McTableData::generate_reusing(3e-5, Some(&data), &quiet).unwrap();
+        assert_eq!(
+            other_scale.to_bytes(),
+            McTableData::generate(3e-5, &quiet).unwrap().to_bytes()
+        );
+        assert!(McTableData::from_bytes_v1(&bytes).is_err());
         // Every table's rows hold their own walks: the total (all escaped weight) is at least
         // the binned weight, and the tables differ.
-        for e in 0..ETAS.len() {
+        for t in 0..GS.len() * ETAS.len() {
             for i in 0..N_RHO {
-                let binned: f64 = data.mass(e, i).iter().sum();
-                let (total, _) = data.total(e, i);
+                let binned: f64 = data.mass(t, i).iter().sum();
+                let (total, _) = data.total(t, i);
                 assert!(
                     total >= binned * (1.0 - 1e-6),
-                    "eta {e} row {i}: {total} < {binned}"
+                    "table {t} row {i}: {total} < {binned}"
                 );
             }
         }
-        assert!((0..N_RHO).any(|i| data.total(0, i) != data.total(ETAS.len() - 1, i)));
+        assert!((0..N_RHO).any(|i| data.total(0, i) != data.total(GS.len() * ETAS.len() - 1, i)));
         // Any damage is an error, never a panic.
         for at in [0, 9, 40, bytes.len() / 2, bytes.len() - 1] {
             let mut bad = bytes.clone();
@@ -1798,9 +2113,13 @@ mod tests {
     fn embedded_table_is_read() {
         let data = McTableData::embedded().unwrap();
         assert_eq!(data.etas(), ETAS);
+        assert_eq!(data.gs(), GS);
         assert_eq!(data.seed(), SEED);
-        for e in 0..ETAS.len() {
-            assert_eq!(data.walks(e), plan(e, 1.0).as_slice(), "eta index {e}");
+        for g in 0..GS.len() {
+            for e in 0..ETAS.len() {
+                let t = data.table_index(g, e);
+                assert_eq!(data.walks(t), plan(g, e, 1.0).as_slice(), "g {g}, eta {e}");
+            }
         }
     }
 
@@ -1841,20 +2160,54 @@ mod tests {
     }
 
     #[test]
-    fn anisotropic_media_use_their_reduced_coefficients() {
-        // σ_s = 2, g = 0.5 has σ'_s = 1: the same model as σ_s = 1, g = 0.
-        let a = Medium::new([0.1, 0.3, 0.0], [2.0, 4.0, 6.0], 0.5, 1.3).unwrap();
-        let b = Medium::new([0.1, 0.3, 0.0], [1.0, 2.0, 3.0], 0.0, 1.3).unwrap();
-        let (ma, mb) = (McTableModel::new(a), McTableModel::new(b));
-        for ch in 0..3 {
-            assert_eq!(ma.reduced_albedo(ch), mb.reduced_albedo(ch));
-            for r in [0.0, 0.01, 0.3, 2.0, 40.0] {
-                assert_eq!(ma.rd(ch, r), mb.rd(ch, r));
-                assert_eq!(ma.pdf_sr(ch, r), mb.pdf_sr(ch, r));
-            }
-            assert_eq!(ma.sample_sr(ch, 0.4), mb.sample_sr(ch, 0.4));
+    fn anisotropic_media_read_the_tables_of_their_g_at_their_reduced_coefficients() {
+        // g = 0.5 lies a third of the way from the 0.4 table to the 0.7 one.
+        let (lo, hi, mid) = (
+            McTable::anisotropic(1.3, 0.4),
+            McTable::anisotropic(1.3, 0.7),
+            McTable::anisotropic(1.3, 0.5),
+        );
+        assert_eq!(mid.g(), 0.5);
+        let mut differ = 0;
+        for ((p, q), m) in lo
+            .profile_values()
+            .iter()
+            .zip(hi.profile_values())
+            .zip(mid.profile_values())
+        {
+            let want = (2.0 * p + q) / 3.0;
+            assert!((m - want).abs() <= 1e-13 * (p + q) + 1e-300);
+            differ += usize::from(p != q);
         }
-        assert!(ma.eta_in_range());
+        assert!(differ > N_RHO, "the tables of g = 0.4 and 0.7 differ");
+        assert_ne!(
+            McTable::anisotropic(1.3, 0.4).profile_values(),
+            McTable::new(1.3).profile_values()
+        );
+        // Outside [0, 0.9]: the end table at the reduced coefficients. σ_s = 2, g = −1/2 has
+        // σ'_s = 3, the same model as σ_s = 3, g = 0; σ_s = 20, g = 0.95 has σ'_s = 1, as
+        // σ_s = 10, g = 0.9.
+        for ((sa, ga), (sb, gb)) in [((2.0, -0.5), (3.0, 0.0)), ((20.0, 0.95), (10.0, 0.9))] {
+            let a = Medium::new([0.1, 0.3, 0.0], [sa, 2.0 * sa, 3.0 * sa], ga, 1.3).unwrap();
+            let b = Medium::new([0.1, 0.3, 0.0], [sb, 2.0 * sb, 3.0 * sb], gb, 1.3).unwrap();
+            let (ma, mb) = (McTableModel::new(a), McTableModel::new(b));
+            assert!(!ma.g_in_range() && mb.g_in_range());
+            for ch in 0..3 {
+                let (x, y) = (ma.reduced_albedo(ch), mb.reduced_albedo(ch));
+                assert!((x - y).abs() < 1e-15, "{x} vs {y}");
+                for r in [0.0, 0.01, 0.3, 2.0, 40.0] {
+                    let (x, y) = (ma.rd(ch, r), mb.rd(ch, r));
+                    assert!(
+                        (x - y).abs() <= 1e-12 * y,
+                        "g {ga} ch {ch} r {r}: {x} vs {y}"
+                    );
+                }
+            }
+        }
+        assert!(g_in_range(0.0) && g_in_range(0.9) && g_in_range(0.55));
+        assert!(!g_in_range(-0.01) && !g_in_range(0.91) && !g_in_range(f64::NAN));
+        let a = Medium::new([0.1; 3], [1.0; 3], 0.5, 1.3).unwrap();
+        assert!(McTableModel::new(a).eta_in_range());
         let out = Medium::new([0.1; 3], [1.0; 3], 0.0, 1.7).unwrap();
         assert!(!McTableModel::new(out).eta_in_range());
     }

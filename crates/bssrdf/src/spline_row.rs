@@ -278,6 +278,48 @@ impl SplineRow {
         }
     }
 
+    /// The same row with every segment on which p(x)/x rises (tested at 17 points per
+    /// segment: p′(x) x > p(x), relative 10⁻¹²) replaced by the straight line between its knot
+    /// values (d₀ = d₁ = f₁ − f₀), and the running integral recomputed. For a row of
+    /// T = 2πx R_d whose knot values have R_d non-increasing (T₁/x₁ ≤ T₀/x₀), a straight
+    /// segment of slope s keeps R_d non-increasing: x² (T/x)′ = x₀ (s − T₀/x₀) ≤ 0. Catmull-Rom
+    /// segments can rise after a flat stretch (their end slopes come from the neighbours).
+    /// Segments starting at x ≤ 0 are kept.
+    pub fn monotone_over_x(&self) -> SplineRow {
+        let mut segments = self.segments.clone();
+        for s in segments.iter_mut() {
+            if !(s.x0 > 0.0) {
+                continue;
+            }
+            let rises = (0..=16).any(|k| {
+                let t = k as f64 / 16.0;
+                let p = s.c[0] + t * (s.c[1] + t * (s.c[2] + t * s.c[3]));
+                let dp = s.c[1] + t * (2.0 * s.c[2] + 3.0 * t * s.c[3]);
+                let x = s.x0 + t * s.width;
+                dp * x > s.width * p + 1e-12 * (s.width * p).abs()
+            });
+            if rises {
+                let slope = s.f1 - s.f0;
+                *s = Segment {
+                    d0: slope,
+                    d1: slope,
+                    c: [s.f0, slope, 0.0, 0.0],
+                    ..*s
+                };
+            }
+        }
+        let mut cdf = vec![0.0; segments.len() + 1];
+        for (i, s) in segments.iter().enumerate() {
+            // ∫ over the segment: w ((f₀ + f₁)/2 + (d₀ − d₁)/12) (pbrt §8.6.1).
+            cdf[i + 1] = cdf[i] + s.width * (0.5 * (s.f0 + s.f1) + (s.d0 - s.d1) / 12.0);
+        }
+        SplineRow {
+            index: self.index.clone(),
+            segments,
+            cdf,
+        }
+    }
+
     /// The row through `values` (one per knot of `index`), its integral computed as in
     /// [`crate::catmull_rom::integrate_catmull_rom`].
     pub fn new(index: &KnotIndex, values: &[f64]) -> Self {

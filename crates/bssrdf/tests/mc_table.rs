@@ -13,7 +13,7 @@
 //! Sampling (`pdf_sr`, quantiles, Kolmogorov-Smirnov) and the extreme media are covered with
 //! the other models in `sampling_at_table_speed.rs`, `models.rs` and `extremes.rs`.
 
-use sss_bssrdf::mc_table::{ETAS, McTable, McTableData, tally_edges};
+use sss_bssrdf::mc_table::{ETAS, GS, McTable, McTableData, tally_edges};
 use sss_bssrdf::monte_carlo::{BinSpacing, McConfig, simulate};
 use sss_bssrdf::quadrature::integrate_radial_range;
 use sss_bssrdf::*;
@@ -46,24 +46,30 @@ fn fresh(
 
 #[test]
 fn table_entries_agree_with_a_fresh_ordinary_walk() {
-    // (η index, albedo row, photons): one row from a single-stratum band and three from
-    // stratified bands, at three η. A fresh bin enters the test when it has at least ~25
-    // photons' worth of tally (relative standard error ≤ 20 %, where its error is close to
-    // normal). Margins: every |z| < 4.5 (≈ 300 bins: a false alarm below 0.3 %) and χ² within
-    // 4 standard deviations of its mean.
+    // (g index, η index, albedo row, photons): one row from a single-stratum band and three
+    // from stratified bands, at three η, for g = 0, and three rows of the tables of g ≠ 0. A
+    // table of g ≠ 0 is in reduced units: its row ρ' and radius x' are those of the medium
+    // σ_a = 1 − ρ', σ_s = ρ'/(1 − g) (σ'_t = 1), simulated here with its true g. A fresh bin
+    // enters the test when it has at least ~25 photons' worth of tally (relative standard
+    // error ≤ 20 %, where its error is close to normal). Margins: every |z| < 4.5 (≈ 500
+    // bins: a false alarm below 0.4 %) and χ² within 4 standard deviations of its mean.
     let data = McTableData::embedded().unwrap();
     let edges = tally_edges(data.knots());
     let cases = [
-        (3, 40, 200_000),
-        (3, 75, 40_000),
-        (0, 20, 200_000),
-        (5, 88, 15_000),
+        (0, 3, 40, 200_000),
+        (0, 3, 75, 40_000),
+        (0, 0, 20, 200_000),
+        (0, 5, 88, 15_000),
+        (1, 3, 30, 100_000),
+        (3, 0, 55, 40_000),
+        (4, 4, 70, 10_000),
     ];
     let (mut chi2, mut dof) = (0.0, 0usize);
     let mut worst: f64 = 0.0;
-    for (e, i, photons) in cases {
-        let (eta, rho) = (ETAS[e], data.rho_samples()[i]);
-        let m = Medium::from_extinction_albedo([1.0; 3], [rho; 3], 0.0, eta).unwrap();
+    for (gi, e, i, photons) in cases {
+        let (g, eta, rho) = (GS[gi], ETAS[e], data.rho_samples()[i]);
+        let m = Medium::new([1.0 - rho; 3], [rho / (1.0 - g); 3], g, eta).unwrap();
+        let e = data.table_index(gi, e);
         let mc = fresh(
             &m,
             0,
@@ -81,7 +87,7 @@ fn table_entries_agree_with_a_fresh_ordinary_walk() {
             let z = (table[b] - f) / (table_se[b].powi(2) + f_se.powi(2)).sqrt();
             assert!(
                 z.abs() < 4.5,
-                "eta {eta} rho {rho} bin {b} [{}, {}]: table {} ± {} vs fresh {f} ± {f_se}",
+                "g {g} eta {eta} rho {rho} bin {b} [{}, {}]: table {} ± {} vs fresh {f} ± {f_se}",
                 edges[b],
                 edges[b + 1],
                 table[b],
@@ -91,16 +97,19 @@ fn table_entries_agree_with_a_fresh_ordinary_walk() {
             chi2 += z * z;
             used += 1;
         }
-        assert!(used >= 30, "eta {eta} rho {rho}: only {used} bins compared");
+        assert!(
+            used >= 30,
+            "g {g} eta {eta} rho {rho}: only {used} bins compared"
+        );
         dof += used;
         let (t, t_se) = data.total(e, i);
         let z = (t - mc.total[0]) / (t_se.powi(2) + mc.total_se[0].powi(2)).sqrt();
         println!(
-            "eta {eta} rho {rho:.6}: {used} bins, total {t:.5} ± {t_se:.1e} vs fresh {:.5} ± \
+            "g {g} eta {eta} rho {rho:.6}: {used} bins, total {t:.5} ± {t_se:.1e} vs fresh {:.5} ± \
              {:.1e} (z {z:.2})",
             mc.total[0], mc.total_se[0]
         );
-        assert!(z.abs() < 4.0, "eta {eta} rho {rho}: total z {z}");
+        assert!(z.abs() < 4.0, "g {g} eta {eta} rho {rho}: total z {z}");
     }
     let bound = dof as f64 + 4.0 * (2.0 * dof as f64).sqrt();
     println!("{dof} bins: chi2 {chi2:.1} (bound {bound:.1}), worst |z| {worst:.2}");
@@ -112,6 +121,11 @@ struct Case {
     label: &'static str,
     medium: Medium,
     photons: [u64; 3],
+}
+
+/// `m` (g = 0) with anisotropy `g` and the same reduced scattering coefficient.
+fn with_g(m: Medium, g: f64) -> Medium {
+    Medium::new(m.sigma_a(), m.sigma_s().map(|s| s / (1.0 - g)), g, m.eta()).unwrap()
 }
 
 fn accuracy_cases() -> Vec<Case> {
@@ -127,6 +141,18 @@ fn accuracy_cases() -> Vec<Case> {
             label: "marble",
             medium: Medium::preset("marble").unwrap(),
             photons: [30_000; 3],
+        },
+        // Anisotropic media between the tables of g: the measured reduced coefficients of
+        // marble with g = 0.5 (σ_s = σ'_s/(1 − g)) and of skin1 with g = 0.8.
+        Case {
+            label: "marble g 0.5",
+            medium: with_g(Medium::preset("marble").unwrap(), 0.5),
+            photons: [20_000; 3],
+        },
+        Case {
+            label: "skin1 g 0.8",
+            medium: with_g(Medium::preset("skin1").unwrap(), 0.8),
+            photons: [60_000; 3],
         },
         // η = 1.33 lies between the 1.3 and 1.4 tables; albedos between rows.
         Case {
@@ -145,7 +171,8 @@ fn accuracy_cases() -> Vec<Case> {
 
 #[test]
 fn within_three_percent_of_monte_carlo_off_the_nodes() {
-    // Bins: [0, 0.25] then 24 log-spaced up to 16 mean free paths (1/σ_t) of the channel; the
+    // Bins: [0, 0.25] then 24 log-spaced up to 16 reduced mean free paths (1/σ'_t; 1/σ_t for
+    // g = 0) of the channel; the
     // model's area average over each bin by quadrature of its rd. A bin passes when
     // |model − MC| ≤ 3 % MC + 3 SE(MC); the total when |model − MC| ≤ 1 % MC + 3 SE(MC).
     let mut worst_excess: f64 = 0.0;
@@ -153,7 +180,7 @@ fn within_three_percent_of_monte_carlo_off_the_nodes() {
     for case in accuracy_cases() {
         let model = make_model(ModelKind::McTable, &case.medium);
         for ch in 0..3 {
-            let mfp = case.medium.mean_free_path(ch);
+            let mfp = case.medium.reduced_mean_free_path(ch);
             let spacing = BinSpacing::geometric(0.25 * mfp, 16.0 * mfp, 25).unwrap();
             let mc = fresh(
                 &case.medium,
@@ -162,7 +189,7 @@ fn within_three_percent_of_monte_carlo_off_the_nodes() {
                 0xACC + ch as u64,
                 spacing,
             );
-            let albedo = case.medium.albedo(ch);
+            let albedo = case.medium.reduced_albedo(ch);
             let mut line = format!("{} ch{ch} albedo {albedo:.5}:", case.label);
             for (b, w) in mc.bin_edges.windows(2).enumerate().skip(1) {
                 let area = mc.bin_areas()[b];
@@ -228,21 +255,31 @@ fn worst_rise(model: &dyn Bssrdf, ch: usize) -> f64 {
 #[test]
 fn profiles_are_non_increasing_and_totals_non_decreasing() {
     // Every table row and the midpoints between rows, at every η of the tables and between
-    // two of them.
+    // two of them (g = 0), and at every g of the tables and between two of them (the media
+    // of reduced albedo ρ' and σ'_t = 1).
     let rows = McTable::new(1.3).rho_samples().to_vec();
     let mut albedos = rows.clone();
     albedos.extend(rows.windows(2).map(|w| 0.5 * (w[0] + w[1])));
     let mut worst: (f64, String) = (0.0, String::new());
-    for eta in ETAS.into_iter().chain([1.35]) {
+    let cases = ETAS
+        .into_iter()
+        .chain([1.35])
+        .map(|eta| (eta, 0.0))
+        .chain(GS[1..].iter().chain(&[0.5]).map(|&g| (1.3, g)))
+        .chain([(1.0, 0.9), (1.5, 0.7)]);
+    let medium = |a: [f64; 3], g: f64, eta: f64| {
+        Medium::new(a.map(|a| 1.0 - a), a.map(|a| a / (1.0 - g)), g, eta).unwrap()
+    };
+    for (eta, g) in cases {
         for chunk in albedos.chunks(3) {
             let mut a = [0.0; 3];
             a[..chunk.len()].copy_from_slice(chunk);
-            let m = Medium::from_extinction_albedo([1.0; 3], a, 0.0, eta).unwrap();
+            let m = medium(a, g, eta);
             let model = McTableModel::new(m);
             for (ch, &rho) in chunk.iter().enumerate() {
                 let rise = worst_rise(&model, ch);
                 if rise > worst.0 {
-                    worst = (rise, format!("eta {eta} rho {rho}"));
+                    worst = (rise, format!("eta {eta} g {g} rho {rho}"));
                 }
             }
         }
@@ -250,11 +287,10 @@ fn profiles_are_non_increasing_and_totals_non_decreasing() {
         let mut prev = 0.0;
         for k in 0..=4000 {
             let rho = k as f64 / 4000.0;
-            let m = Medium::from_extinction_albedo([1.0; 3], [rho; 3], 0.0, eta).unwrap();
-            let v = McTableModel::new(m).total_diffuse_reflectance(0);
+            let v = McTableModel::new(medium([rho; 3], g, eta)).total_diffuse_reflectance(0);
             assert!(
                 v >= prev - 1e-12 && v <= 1.0,
-                "eta {eta} rho {rho}: {v} after {prev}"
+                "eta {eta} g {g} rho {rho}: {v} after {prev}"
             );
             prev = v;
         }
@@ -276,8 +312,10 @@ fn table_totals_hold_the_monte_carlo_totals() {
     // keeping its tallied mass loses 0.9 % there.
     let data = McTableData::embedded().unwrap();
     let mut worst: (f64, String) = (0.0, String::new());
-    for (e, &eta) in ETAS.iter().enumerate() {
-        let table = McTable::new(eta);
+    for (gi, e) in (0..GS.len()).flat_map(|g| (0..ETAS.len()).map(move |e| (g, e))) {
+        let (g, eta) = (GS[gi], ETAS[e]);
+        let table = McTable::anisotropic(eta, g);
+        let e = data.table_index(gi, e);
         for (i, &rho) in data.rho_samples().iter().enumerate() {
             if rho < 0.5 {
                 continue;
@@ -289,7 +327,7 @@ fn table_totals_hold_the_monte_carlo_totals() {
                 worst = (
                     rel,
                     format!(
-                        "eta {eta} rho {rho}: {got} vs {inside} (all radii {})",
+                        "eta {eta} g {g} rho {rho}: {got} vs {inside} (all radii {})",
                         data.total(e, i).0
                     ),
                 );
@@ -315,8 +353,9 @@ fn splines_integrate_to_the_tallies() {
     let data = McTableData::embedded().unwrap();
     let edges = tally_edges(data.knots());
     let (mut sum, mut n) = (0.0, 0usize);
-    for (e, &eta) in ETAS.iter().enumerate() {
-        let table = McTable::new(eta);
+    for (gi, e) in (0..GS.len()).flat_map(|g| (0..ETAS.len()).map(move |e| (g, e))) {
+        let table = McTable::anisotropic(ETAS[e], GS[gi]);
+        let e = data.table_index(gi, e);
         let xs = table.radius_samples().to_vec();
         for i in 0..data.rho_samples().len() {
             let (mass, se) = (data.mass(e, i), data.mass_se(e, i));
@@ -347,5 +386,5 @@ fn splines_integrate_to_the_tallies() {
     }
     let mean = sum / n as f64;
     println!("{n} resolved bins: mean z² {mean:.3}");
-    assert!(n > 30_000 && mean < 1.0, "{n} bins, mean z² {mean}");
+    assert!(n > 150_000 && mean < 1.0, "{n} bins, mean z² {mean}");
 }

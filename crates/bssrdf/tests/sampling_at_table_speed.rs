@@ -86,10 +86,12 @@ impl<'a> Cdf<'a> {
 }
 
 /// Quadrature tolerance of the quantile check: the directional dipole's pdf is piecewise
-/// linear (kinks inside Gauss panels), the others are smooth or C¹ splines.
+/// linear (kinks inside Gauss panels), and so are the segments of `mc-table` rows straightened
+/// to keep R_d non-increasing (`SplineRow::monotone_over_x`); the others are smooth or C¹
+/// splines.
 fn tolerance(kind: ModelKind) -> f64 {
     match kind {
-        ModelKind::DirectionalDipole => 2e-7,
+        ModelKind::DirectionalDipole | ModelKind::McTable => 2e-7,
         _ => 1e-8,
     }
 }

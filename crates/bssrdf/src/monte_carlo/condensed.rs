@@ -69,6 +69,13 @@ pub struct CondensedConfig {
     /// Walks stop at collision `max_events + 1` (≤ [`MAX_SCATTERING_EVENTS`]); weight still
     /// carried then is reported in [`CondensedProfile::capped_weight`].
     pub max_events: u64,
+    /// Per row, a factor applied to the exit radius before it is binned (each finite and > 0),
+    /// or empty for 1 on every row. Row i is then tallied at radius s_i r: with
+    /// s_i = 1 − ρ_i g, the reduced extinction σ'_t of row i's medium (σ_t = 1), its bins are
+    /// in reduced mean free paths — what lets the `mc-table` tables for g ≠ 0 share the rows
+    /// and radii of g = 0 (see [`crate::mc_table`]). The geometry of the walk does not depend
+    /// on the scale, so the rows still share their photons.
+    pub radius_scales: Vec<f64>,
 }
 
 impl CondensedConfig {
@@ -110,6 +117,17 @@ impl CondensedConfig {
             return bad(format!(
                 "condensed Monte Carlo: collision range {}..={} must lie in 1..={MAX_SCATTERING_EVENTS}",
                 self.min_events, self.max_events
+            ));
+        }
+        let scales_ok = self.radius_scales.is_empty()
+            || (self.radius_scales.len() == self.albedos.len()
+                && self.radius_scales.iter().all(|s| *s > 0.0 && s.is_finite()));
+        if !scales_ok {
+            return bad(format!(
+                "condensed Monte Carlo: {} radius scales for {} albedos; give none or one finite \
+                 positive scale per albedo",
+                self.radius_scales.len(),
+                self.albedos.len()
             ));
         }
         if self.albedos.len().saturating_mul(bins) > MAX_CELLS {
@@ -233,6 +251,12 @@ pub fn simulate_albedos(cfg: &CondensedConfig) -> Result<CondensedProfile, Bssrd
         .iter()
         .map(|&a| if rho_max > 0.0 { a / rho_max } else { 0.0 })
         .collect();
+    // Scales of exactly 1 take the one-bin-per-escape path (the g = 0 tables).
+    let scales: &[f64] = if cfg.radius_scales.iter().all(|&s| s == 1.0) {
+        &[]
+    } else {
+        &cfg.radius_scales
+    };
     let r_max = cfg.edges[bins];
     let walk = Walk {
         sigma_t: 1.0,
@@ -257,7 +281,7 @@ pub fn simulate_albedos(cfg: &CondensedConfig) -> Result<CondensedProfile, Bssrd
             .map(|k| {
                 let n = CHUNK_PHOTONS.min(cfg.photons - k * CHUNK_PHOTONS);
                 let seed = chunk_seed(cfg.seed, cfg.stream, k);
-                run_chunk(&walk, &ratios, cfg.min_events, n, seed)
+                run_chunk(&walk, &ratios, scales, cfg.min_events, n, seed)
             })
             .collect();
         for t in &results {
@@ -295,7 +319,14 @@ pub fn simulate_albedos(cfg: &CondensedConfig) -> Result<CondensedProfile, Bssrd
     })
 }
 
-fn run_chunk(walk: &Walk, ratios: &[f64], min_events: u64, photons: u64, seed: u64) -> Tally {
+fn run_chunk(
+    walk: &Walk,
+    ratios: &[f64],
+    scales: &[f64],
+    min_events: u64,
+    photons: u64,
+    seed: u64,
+) -> Tally {
     let rows = ratios.len();
     let bins = walk.bins;
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
@@ -320,14 +351,26 @@ fn run_chunk(walk: &Walk, ratios: &[f64], min_events: u64, photons: u64, seed: u
             for (t, x) in scratch.total.iter_mut().zip(&scratch.weights) {
                 *t += x;
             }
-            if let Some(b) = walk.bin(r) {
-                if !scratch.is_touched[b] {
-                    scratch.is_touched[b] = true;
-                    scratch.touched.push(b);
+            if scales.is_empty() {
+                if let Some(b) = walk.bin(r) {
+                    if !scratch.is_touched[b] {
+                        scratch.is_touched[b] = true;
+                        scratch.touched.push(b);
+                    }
+                    let cell = &mut scratch.cell[b * rows..(b + 1) * rows];
+                    for (c, x) in cell.iter_mut().zip(&scratch.weights) {
+                        *c += x;
+                    }
                 }
-                let cell = &mut scratch.cell[b * rows..(b + 1) * rows];
-                for (c, x) in cell.iter_mut().zip(&scratch.weights) {
-                    *c += x;
+            } else {
+                for (i, (&s, x)) in scales.iter().zip(&scratch.weights).enumerate() {
+                    if let Some(b) = walk.bin(s * r) {
+                        if !scratch.is_touched[b] {
+                            scratch.is_touched[b] = true;
+                            scratch.touched.push(b);
+                        }
+                        scratch.cell[b * rows + i] += x;
+                    }
                 }
             }
         });
@@ -376,6 +419,7 @@ mod tests {
             edges: vec![0.0, 0.3, 1.0, 2.5, 6.0],
             min_events: 1,
             max_events: MAX_SCATTERING_EVENTS,
+            radius_scales: Vec::new(),
         }
     }
 
@@ -413,6 +457,59 @@ mod tests {
                 assert!(p.row_mass(0)[b] < p.row_mass(1)[b]);
                 assert!(p.row_mass(1)[b] < p.row_mass(2)[b]);
             }
+        }
+    }
+
+    #[test]
+    fn a_radius_scale_bins_the_row_at_the_scaled_radius() {
+        // Row ρ_max with scale 1/2 against `simulate` with every edge doubled: r/2 ≥ e exactly
+        // when r ≥ 2e (both exact in binary), so the same photons fall in the same bins. The
+        // other row keeps scale 1 and its plain bins.
+        let c = CondensedConfig {
+            g: 0.6,
+            radius_scales: vec![1.0, 0.5],
+            ..config(2 * CHUNK_PHOTONS + 3, vec![0.5, 0.8], 1.3)
+        };
+        let p = simulate_albedos(&c).unwrap();
+        let plain = simulate_albedos(&CondensedConfig {
+            radius_scales: Vec::new(),
+            ..c.clone()
+        })
+        .unwrap();
+        assert_eq!(p.row_mass(0), plain.row_mass(0));
+        assert_eq!(p.total, plain.total);
+        assert_ne!(p.row_mass(1), plain.row_mass(1));
+        let m = Medium::from_extinction_albedo([1.0; 3], [0.8; 3], 0.6, 1.3).unwrap();
+        let doubled: Vec<f64> = c.edges.iter().map(|e| 2.0 * e).collect();
+        let mc = simulate(
+            &m,
+            &McConfig {
+                photons: c.photons,
+                seed: c.seed,
+                r_max: doubled[doubled.len() - 1],
+                bins: 4,
+                channels: [true, false, false],
+                spacing: BinSpacing::Edges(doubled),
+            },
+        )
+        .unwrap();
+        for (b, area) in mc.bin_areas().iter().enumerate() {
+            let want = mc.rd[0][b] * area;
+            assert!(want > 0.0);
+            assert!((p.row_mass(1)[b] - want).abs() <= 1e-14 * want, "bin {b}");
+        }
+        // One scale per albedo, each finite and positive.
+        for bad in [
+            vec![1.0],
+            vec![1.0, 0.0],
+            vec![1.0, f64::NAN],
+            vec![1.0, -1.0],
+        ] {
+            let c = CondensedConfig {
+                radius_scales: bad,
+                ..c.clone()
+            };
+            assert!(simulate_albedos(&c).is_err(), "{:?}", c.radius_scales);
         }
     }
 
