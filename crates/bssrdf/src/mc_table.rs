@@ -1562,20 +1562,31 @@ impl McTable {
     }
 }
 
+/// The two entries of the increasing `grid` (≥ 2 values) around `v` (already clamped to it)
+/// and the weight of the upper one.
+fn bracket(grid: &[f64], v: f64) -> (usize, usize, f64) {
+    let hi = grid.partition_point(|&x| x <= v).clamp(1, grid.len() - 1);
+    let (a, b) = (grid[hi - 1], grid[hi]);
+    (hi - 1, hi, ((v - a) / (b - a)).clamp(0.0, 1.0))
+}
+
+/// `v` clamped to the range of the increasing `grid`, NaN to `nan`.
+fn clamp_to(grid: &[f64], v: f64, nan: f64) -> f64 {
+    if v.is_nan() {
+        nan
+    } else {
+        v.clamp(grid[0], grid[grid.len() - 1])
+    }
+}
+
 /// The two tables of [`ETAS`] around `eta` (already clamped) and the weight of the upper one.
 fn eta_bracket(eta: f64) -> (usize, usize, f64) {
-    let hi = ETAS.partition_point(|&e| e <= eta).clamp(1, ETAS.len() - 1);
-    let (e0, e1) = (ETAS[hi - 1], ETAS[hi]);
-    (hi - 1, hi, ((eta - e0) / (e1 - e0)).clamp(0.0, 1.0))
+    bracket(&ETAS, eta)
 }
 
 /// η clamped to the range of [`ETAS`] (NaN to [`MAIN_ETA`]).
 fn clamp_eta(eta: f64) -> f64 {
-    if eta.is_nan() {
-        MAIN_ETA
-    } else {
-        eta.clamp(ETAS[0], ETAS[ETAS.len() - 1])
-    }
+    clamp_to(&ETAS, eta, MAIN_ETA)
 }
 
 /// True when `eta` lies in the range of [`ETAS`], where the tables are interpolated rather
@@ -1586,18 +1597,12 @@ pub fn eta_in_range(eta: f64) -> bool {
 
 /// The two tables of [`GS`] around `g` (already clamped) and the weight of the upper one.
 fn g_bracket(g: f64) -> (usize, usize, f64) {
-    let hi = GS.partition_point(|&x| x <= g).clamp(1, GS.len() - 1);
-    let (g0, g1) = (GS[hi - 1], GS[hi]);
-    (hi - 1, hi, ((g - g0) / (g1 - g0)).clamp(0.0, 1.0))
+    bracket(&GS, g)
 }
 
 /// g clamped to the range of [`GS`] (NaN to 0).
 fn clamp_g(g: f64) -> f64 {
-    if g.is_nan() {
-        0.0
-    } else {
-        g.clamp(GS[0], GS[GS.len() - 1])
-    }
+    clamp_to(&GS, g, 0.0)
 }
 
 /// True when `g` lies in the range of [`GS`], where the tables are interpolated; a medium

@@ -140,6 +140,19 @@ struct Segment {
     c: [f64; 4],
 }
 
+impl Segment {
+    /// The straight line between the segment's knot values (d₀ = d₁ = f₁ − f₀).
+    fn straight(&self) -> Segment {
+        let slope = self.f1 - self.f0;
+        Segment {
+            d0: slope,
+            d1: slope,
+            c: [self.f0, slope, 0.0, 0.0],
+            ..*self
+        }
+    }
+}
+
 /// A 1D Catmull-Rom spline row with its running integral (see the module docs).
 #[derive(Clone, Debug)]
 pub struct SplineRow {
@@ -258,14 +271,13 @@ impl SplineRow {
     pub fn with_linear_first_segment(&self) -> SplineRow {
         let mut segments = self.segments.clone();
         if let Some(s) = segments.first_mut() {
-            let slope = s.f1 - s.f0;
-            *s = Segment {
-                d0: slope,
-                d1: slope,
-                c: [s.f0, slope, 0.0, 0.0],
-                ..*s
-            };
+            *s = s.straight();
         }
+        self.with_segments(segments)
+    }
+
+    /// A row of this row's knots with `segments`, its running integral recomputed.
+    fn with_segments(&self, segments: Vec<Segment>) -> SplineRow {
         let mut cdf = vec![0.0; segments.len() + 1];
         for (i, s) in segments.iter().enumerate() {
             // ∫ over the segment: w ((f₀ + f₁)/2 + (d₀ − d₁)/12) (pbrt §8.6.1).
@@ -299,25 +311,10 @@ impl SplineRow {
                 dp * x > s.width * p + 1e-12 * (s.width * p).abs()
             });
             if rises {
-                let slope = s.f1 - s.f0;
-                *s = Segment {
-                    d0: slope,
-                    d1: slope,
-                    c: [s.f0, slope, 0.0, 0.0],
-                    ..*s
-                };
+                *s = s.straight();
             }
         }
-        let mut cdf = vec![0.0; segments.len() + 1];
-        for (i, s) in segments.iter().enumerate() {
-            // ∫ over the segment: w ((f₀ + f₁)/2 + (d₀ − d₁)/12) (pbrt §8.6.1).
-            cdf[i + 1] = cdf[i] + s.width * (0.5 * (s.f0 + s.f1) + (s.d0 - s.d1) / 12.0);
-        }
-        SplineRow {
-            index: self.index.clone(),
-            segments,
-            cdf,
-        }
+        self.with_segments(segments)
     }
 
     /// The row through `values` (one per knot of `index`), its integral computed as in
