@@ -392,6 +392,60 @@ impl SplineRow {
 mod tests {
     use super::*;
 
+    #[test]
+    fn monotone_over_x_straightens_only_the_segments_where_value_over_x_rises() {
+        // T = x R with R flat from 2 to 4, then dropping: the Catmull-Rom segment [3, 4] takes
+        // its end slope from the drop and bulges, so T/x rises inside it.
+        let knots = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let r = [1.0, 1.0, 0.5, 0.5, 0.5, 0.05, 0.04];
+        let values: Vec<f64> = knots.iter().zip(r).map(|(x, r)| x * r).collect();
+        let index = KnotIndex::new(&knots).unwrap();
+        let row = SplineRow::new(&index, &values);
+        let rises = |row: &SplineRow| {
+            // The largest rise of T/x over its running minimum, from the first knot after 0
+            // (the segment from x = 0 is kept as it is).
+            let mut least = f64::INFINITY;
+            let mut worst: f64 = 0.0;
+            for k in 1000..=6000 {
+                let x = k as f64 * 1e-3;
+                let v = row.eval(x) / x;
+                worst = worst.max(v - least);
+                least = least.min(v);
+            }
+            worst
+        };
+        assert!(rises(&row) > 1e-3, "the example must rise: {}", rises(&row));
+        let mono = row.monotone_over_x();
+        assert!(rises(&mono) <= 1e-12, "{}", rises(&mono));
+        // Each segment is either unchanged or the line between its knots; [3, 4] is straight,
+        // the first is kept (x₀ = 0).
+        let (mut kept, mut straight) = (0, 0);
+        for i in 0..knots.len() - 1 {
+            let mid = 0.5 * (knots[i] + knots[i + 1]);
+            let line = 0.5 * (values[i] + values[i + 1]);
+            if mono.eval(mid) == row.eval(mid) {
+                kept += 1;
+            } else {
+                assert!((mono.eval(mid) - line).abs() < 1e-14, "segment {i}");
+                straight += 1;
+            }
+        }
+        assert!((mono.eval(3.5) - 0.5 * (values[3] + values[4])).abs() < 1e-14);
+        assert_eq!(mono.eval(0.5), row.eval(0.5));
+        assert!(
+            kept >= 2 && straight >= 1,
+            "{kept} kept, {straight} straight"
+        );
+        // The running integral is that of the new segments.
+        let want = quadrature_cdf(&mono, &knots, 6.0);
+        assert!(
+            (mono.total() - want).abs() < 1e-12,
+            "{} vs {want}",
+            mono.total()
+        );
+        assert!((mono.total() - row.total()).abs() > 1e-6);
+    }
+
     /// ∫₀ˣ of the row by Gauss–Legendre quadrature over each knot interval: an integral
     /// independent of the row's own running sums.
     fn quadrature_cdf(row: &SplineRow, knots: &[f64], x: f64) -> f64 {
