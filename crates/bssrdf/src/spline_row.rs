@@ -141,6 +141,17 @@ struct Segment {
 }
 
 impl Segment {
+    /// p(t), t in [0, 1] across the segment.
+    #[inline(always)]
+    fn at(&self, t: f64) -> f64 {
+        self.c[0] + t * (self.c[1] + t * (self.c[2] + t * self.c[3]))
+    }
+
+    /// dp/dt.
+    fn slope_at(&self, t: f64) -> f64 {
+        self.c[1] + t * (2.0 * self.c[2] + 3.0 * t * self.c[3])
+    }
+
     /// The straight line between the segment's knot values (d₀ = d₁ = f₁ − f₀).
     fn straight(&self) -> Segment {
         let slope = self.f1 - self.f0;
@@ -305,8 +316,7 @@ impl SplineRow {
             }
             let rises = (0..=16).any(|k| {
                 let t = k as f64 / 16.0;
-                let p = s.c[0] + t * (s.c[1] + t * (s.c[2] + t * s.c[3]));
-                let dp = s.c[1] + t * (2.0 * s.c[2] + 3.0 * t * s.c[3]);
+                let (p, dp) = (s.at(t), s.slope_at(t));
                 let x = s.x0 + t * s.width;
                 dp * x > s.width * p + 1e-12 * (s.width * p).abs()
             });
@@ -342,7 +352,7 @@ impl SplineRow {
         }
         let s = &self.segments[self.index.interval(x)];
         let t = ((x - s.x0) * s.inv_width).min(1.0);
-        s.c[0] + t * (s.c[1] + t * (s.c[2] + t * s.c[3]))
+        s.at(t)
     }
 
     /// The spline divided by x, for a row that vanishes at x₀ = 0 (a tabulated 2πr R_d): in
