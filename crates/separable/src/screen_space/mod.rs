@@ -25,9 +25,9 @@
 //!
 //! Evaluation: rows are cut into chunks of 64 pixels (`rows.rs`). A chunk whose pixels all
 //! show one blurred object, and whose taps can only reach texels of that object within the
-//! depth threshold, runs every tap as one loop over the chunk with contiguous reads and no
-//! per-texel tests; that test is hoisted into a per-frame summary of object ids and depth
-//! ranges per 16-pixel cell (and per 8-row band), so a chunk checks a few cells. The others
+//! depth threshold, runs every tap over the chunk with contiguous reads and no per-texel
+//! tests; that test is hoisted into a per-frame summary of object ids, depth ranges and
+//! footprints per 16-pixel cell (and per 8-row band), so a chunk checks a few cells. The others
 //! (near silhouettes, mixed or skipped pixels) retry as 16-pixel pieces, then go pixel by
 //! pixel (`pixel.rs`: the straightforward form, each texel tested, the reference). The chunked
 //! form computes the same taps at the same positions (each pixel's tap positions are the
@@ -36,19 +36,26 @@
 //! 10⁻⁵ relative per pixel and channel, with an absolute floor of 10⁻⁶ of the channel's
 //! largest value for pixels near zero (signed kernels cancel); tested on synthetic frames and
 //! on every built-in scene. Which pixels take which form depends only on the inputs, so the
-//! result is identical for any thread count. On x86-64 the chunk loops are also compiled for
-//! AVX2 and FMA and picked at run time (the call into that build after the CPU check is
-//! `unsafe`, and so are the raw 8-float loads of the rotated taps in that build, after one
-//! bounds check per chunk: the portable form of that loop compiles to about twice the
-//! instructions); the baseline build multiplies and adds separately, so the two builds differ
-//! by rounding. Cost and its breakdown: `crates/bench/benches/separable.rs` and
-//! the README.
+//! result is identical for any thread count.
+//!
+//! On x86-64 with AVX2 and FMA (checked at run time) the chunks run in `groups.rs`: groups of
+//! 8 pixels whose 24 sums stay in registers, taps as the outer loop so that a tap's integer
+//! offset and runs are found once per chunk, per-pixel fractions spread over the channels by
+//! permutes, rotated taps as two 8-float loads per pixel. It is written with intrinsics, and
+//! its loads from positions checked once per chunk (or per group, for the rotated taps) are
+//! `unsafe`: the portable loops (`rows.rs`, kept for other CPUs and tested against the same
+//! reference as `Evaluation::RowsBaseline`) compile to memory-resident arrays and about 1.4×
+//! the time without jitter on the benchmark frame (README). The baseline build multiplies
+//! and adds separately, so the two builds differ by rounding. Cost and its breakdown:
+//! `crates/bench/benches/separable.rs` and the README.
 //!
 //! Output: per pixel, the diffuse exitance E ∗ R_d (with [`crate::Energy::TotalReflectance`]
 //! kernels); the caller applies its Fresnel / π factors. Background pixels
 //! ([`NO_OBJECT`]) output 0. Rows are processed in parallel with rayon; every pixel's value
 //! depends only on the inputs, so the result is identical for any thread count.
 
+#[cfg(target_arch = "x86_64")]
+mod groups;
 mod pixel;
 mod rows;
 
@@ -333,10 +340,10 @@ fn run(
     let rules = Rules::new(support, opts);
     let jitter = opts.jitter_radius > 0.0;
     let rotate_limit_mm = opts.jitter_radius * support as f32;
-    let rotations: Vec<(f32, f32)> = (0..ROTATION_STEPS)
+    let rotations: Vec<[f32; 2]> = (0..ROTATION_STEPS)
         .map(|k| {
             let (s, c) = (std::f64::consts::TAU * k as f64 / ROTATION_STEPS as f64).sin_cos();
-            (c as f32, s as f32)
+            [c as f32, s as f32]
         })
         .collect();
     // The chunked form indexes texels in i32 / u32 lanes.
@@ -344,7 +351,7 @@ fn run(
     let baseline = evaluation == Evaluation::RowsBaseline;
     let tables = chunked.then(|| {
         (
-            Summary::new(input),
+            Summary::new(input, &rules),
             PixelTable::new(input, opts.seed, jitter),
         )
     });
@@ -406,10 +413,14 @@ fn rows_of<const VERTICAL: bool, const JITTER: bool>(
     match tables {
         Some((summary, table)) => {
             let taps = ChunkTaps::new(pass);
+            #[cfg(target_arch = "x86_64")]
+            let groups = groups::GroupTaps::new(pass, &taps);
             let ctx = Ctx {
                 summary,
                 table,
                 taps: &taps,
+                #[cfg(target_arch = "x86_64")]
+                groups: &groups,
                 baseline,
             };
             rows.for_each_init(Lanes::new, |lanes, (y, row)| {

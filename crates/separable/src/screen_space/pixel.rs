@@ -64,7 +64,7 @@ pub(super) struct Pass<'a> {
     pub rotate_limit_mm: f32,
     pub seed: u64,
     /// (cos, sin) of every rotation step.
-    pub rotations: &'a [(f32, f32)],
+    pub rotations: &'a [[f32; 2]],
 }
 
 /// Running sums of one pixel.
@@ -119,7 +119,7 @@ impl Pass<'_> {
             any_drop: false,
         };
         let (rdx, rdy) = if self.jitter {
-            let (c, s) = self.rotations[rotation_index(x, y, self.seed)];
+            let [c, s] = self.rotations[rotation_index(x, y, self.seed)];
             if self.vertical { (-s, c) } else { (c, s) }
         } else {
             (0.0, 0.0)
@@ -175,7 +175,7 @@ impl Pass<'_> {
         let (wmax, hmax) = (w as i32 - 1, inp.height as i32 - 1);
         let t = self.taps;
         let (rdx, rdy) = if JITTER {
-            let (c, s) = self.rotations[rotation_index(x, y, self.seed)];
+            let [c, s] = self.rotations[rotation_index(x, y, self.seed)];
             if VERTICAL { (-s, c) } else { (c, s) }
         } else {
             (0.0, 0.0)

@@ -13,8 +13,10 @@
 //! a chunk checks a few cells instead of every texel of every tap (conservatively: a chunk
 //! whose reach touches a mixed cell goes pixel by pixel, through [`Pass::pixel`]).
 //!
-//! On the fast path the chunk is a flat run of 3 × [`CHUNK`] floats (the RGB layout of the
-//! images) and each tap is one loop over it:
+//! On x86-64 with AVX2 and FMA the chunks that pass are summed by [`super::groups`]; the
+//! loops here are the portable form, for other CPUs (and `Evaluation::RowsBaseline`). The
+//! chunk is a flat run of 3 × [`CHUNK`] floats (the RGB layout of the images) and each tap
+//! is one loop over it:
 //! - an axis-aligned tap computes each pixel's position (then its fraction, repeated over its
 //!   three channels). When the integer offset is the same across the chunk and inside the
 //!   image, it blends two contiguous runs of the source row (horizontal pass) or of the source
@@ -25,12 +27,11 @@
 //! - a rotated (jittered) tap is a bilinear read at a per-pixel angle: positions and cells
 //!   are computed for all pixels at once; when every cell is inside the image, the tap is
 //!   kept and, after the axis taps, each pixel sums its kept rotated taps with two 8-float
-//!   loads per tap (the cell's two texels of a row are six contiguous floats; AVX2 intrinsics
-//!   in the AVX2 build, whose raw loads are the crate's second `unsafe`, after one bounds
-//!   check per chunk); near the border each pixel reads its four clamped texels.
+//!   loads per tap (the cell's two texels of a row are six contiguous floats); near the
+//!   border each pixel reads its four clamped texels.
 
 use super::pixel::{Pass, PassTaps};
-use super::{NO_OBJECT, ScreenInput, rotation_index};
+use super::{NO_OBJECT, Rules, ScreenInput, rotation_index};
 use rayon::prelude::*;
 
 /// Pixels per chunk.
@@ -43,8 +44,6 @@ const FLOATS: usize = 3 * CHUNK;
 const ROTATED: usize = 4;
 /// Per held rotated tap, one value per pixel of a chunk.
 type Slots<T> = [[T; CHUNK]; ROTATED];
-/// A rotated tap's row weights at fx = 0 and their change per unit of fx (8 lanes each).
-type RowWeights = ([f32; 8], [f32; 8]);
 /// Pixels per summary cell.
 const CELL: usize = 16;
 
@@ -59,6 +58,10 @@ struct Cell {
     dmin: f32,
     /// Largest depth in the cell.
     dmax: f32,
+    /// Every pixel is blurred (a valid footprint over the sub-pixel limit, [`Rules`]).
+    blurred: bool,
+    /// The largest 1 / mm_per_pixel of the cell's blurred pixels (0 if none).
+    inv_max: f32,
 }
 
 /// Per-row cells of object id and depth range, built once per frame (the silhouette test of a
@@ -82,6 +85,8 @@ impl Cell {
             uniform: self.uniform && o.uniform && self.id == o.id,
             dmin: self.dmin.min(o.dmin),
             dmax: self.dmax.max(o.dmax),
+            blurred: self.blurred && o.blurred,
+            inv_max: self.inv_max.max(o.inv_max),
         }
     }
 
@@ -107,9 +112,54 @@ fn order_bits(key: u32) -> u32 {
     key ^ (!pos | 0x8000_0000)
 }
 
+/// [`summary_row`] compiled for AVX2 (the integer folds run 8 lanes wide).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn summary_row_avx2(input: &ScreenInput, rules: &Rules, y: usize, row: &mut [Cell]) {
+    summary_row(input, rules, y, row)
+}
+
+/// The cells of row `y`.
+#[inline(always)]
+fn summary_row(input: &ScreenInput, rules: &Rules, y: usize, row: &mut [Cell]) {
+    let w = input.width;
+    for (c, cell) in row.iter_mut().enumerate() {
+        let a = y * w + c * CELL;
+        let b = (a + CELL).min(y * w + w);
+        let id = input.mask[a];
+        // Integer folds (they vectorise; float min/max folds do not): a non-finite depth sets
+        // `odd`, and the depth range is the range of order-preserving keys of the finite
+        // depths; the largest inverse footprint is the largest of their bits (positive
+        // floats order as their bits).
+        let mut odd = 0u32;
+        let (mut lo, mut hi) = (u32::MAX, 0u32);
+        for (&m, &d) in input.mask[a..b].iter().zip(&input.depth[a..b]) {
+            let bits = d.to_bits();
+            odd |= (m ^ id) | u32::from(bits & 0x7F80_0000 == 0x7F80_0000);
+            let key = order_key(bits);
+            lo = lo.min(key);
+            hi = hi.max(key);
+        }
+        let (mut skipped, mut inv_bits) = (0u32, 0u32);
+        for &mm in &input.mm_per_pixel[a..b] {
+            let (inv, ok) = rules.inverse_scale_lane(mm);
+            skipped |= u32::from(!ok);
+            inv_bits = inv_bits.max(if ok { inv.to_bits() } else { 0 });
+        }
+        *cell = Cell {
+            id,
+            uniform: id != NO_OBJECT && odd == 0,
+            dmin: f32::from_bits(order_bits(lo)),
+            dmax: f32::from_bits(order_bits(hi)),
+            blurred: skipped == 0,
+            inv_max: f32::from_bits(inv_bits),
+        };
+    }
+}
+
 impl Summary {
-    /// Scans `input`'s mask and depth once.
-    pub fn new(input: &ScreenInput) -> Summary {
+    /// Scans `input`'s mask, depth and footprint once (`rules`: which pixels are blurred).
+    pub fn new(input: &ScreenInput, rules: &Rules) -> Summary {
         let w = input.width;
         let cols = w.div_ceil(CELL);
         let blank = Cell {
@@ -117,35 +167,21 @@ impl Summary {
             uniform: false,
             dmin: 0.0,
             dmax: 0.0,
+            blurred: false,
+            inv_max: 0.0,
         };
         let mut cells = vec![blank; cols * input.height];
         cells
             .par_chunks_mut(cols.max(1))
             .enumerate()
             .for_each(|(y, row)| {
-                for (c, cell) in row.iter_mut().enumerate() {
-                    let a = y * w + c * CELL;
-                    let b = (a + CELL).min(y * w + w);
-                    let id = input.mask[a];
-                    // Integer folds (they vectorise; float min/max folds do not): a
-                    // non-finite depth sets `odd`, and the depth range is the range of
-                    // order-preserving keys of the finite depths.
-                    let mut odd = 0u32;
-                    let (mut lo, mut hi) = (u32::MAX, 0u32);
-                    for (&m, &d) in input.mask[a..b].iter().zip(&input.depth[a..b]) {
-                        let bits = d.to_bits();
-                        odd |= (m ^ id) | u32::from(bits & 0x7F80_0000 == 0x7F80_0000);
-                        let key = order_key(bits);
-                        lo = lo.min(key);
-                        hi = hi.max(key);
-                    }
-                    *cell = Cell {
-                        id,
-                        uniform: id != NO_OBJECT && odd == 0,
-                        dmin: f32::from_bits(order_bits(lo)),
-                        dmax: f32::from_bits(order_bits(hi)),
-                    };
+                #[cfg(target_arch = "x86_64")]
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: the CPU was just checked to support AVX2, the only requirement
+                    // of calling a function compiled with it.
+                    return unsafe { summary_row_avx2(input, rules, y, row) };
                 }
+                summary_row(input, rules, y, row)
             });
         let h = input.height;
         let mut bands = vec![blank; cols * (h + 1).saturating_sub(BAND)];
@@ -168,17 +204,28 @@ impl Summary {
         &self.cells[r + xs.0 / CELL..=r + xs.1 / CELL]
     }
 
-    /// The depth range of columns `xs.0..=xs.1` of row `y` if they all show object `id` with
-    /// finite depths (a superset: whole cells).
+    /// The depth range and the largest 1 / mm_per_pixel of columns `xs.0..=xs.1` of row `y`
+    /// if they all show object `id` with finite depths and are all blurred (whole cells: a
+    /// chunk is a whole number of cells).
     #[inline]
-    fn range(&self, id: u32, y: usize, xs: (usize, usize)) -> Option<(f32, f32)> {
-        let (mut ok, mut lo, mut hi) = (true, f32::INFINITY, f32::NEG_INFINITY);
+    fn range(&self, id: u32, y: usize, xs: (usize, usize)) -> Option<(f32, f32, f32)> {
+        let (mut ok, mut lo, mut hi, mut inv) = (true, f32::INFINITY, f32::NEG_INFINITY, 0.0f32);
         for c in self.cells(y, xs) {
-            ok &= c.uniform & (c.id == id);
+            ok &= c.uniform & (c.id == id) & c.blurred;
             lo = lo.min(c.dmin);
             hi = hi.max(c.dmax);
+            inv = inv.max(c.inv_max);
         }
-        ok.then_some((lo, hi))
+        ok.then_some((lo, hi, inv))
+    }
+
+    /// The largest 1 / mm_per_pixel of row `y`'s blurred pixels.
+    #[cfg(target_arch = "x86_64")]
+    fn row_inv_max(&self, y: usize) -> f32 {
+        let r = y * self.cols;
+        self.cells[r..r + self.cols]
+            .iter()
+            .fold(0.0f32, |a, c| a.max(c.inv_max))
     }
 
     /// Whether every pixel of rows `ys.0..=ys.1`, columns `xs.0..=xs.1` (and the rest of
@@ -212,7 +259,7 @@ impl Summary {
 /// allocation per frame costs more in page faults than the lookup.)
 pub(super) struct PixelTable {
     /// Rotation step of each pixel (empty without jitter).
-    rotation: Vec<u8>,
+    pub(super) rotation: Vec<u8>,
 }
 
 impl PixelTable {
@@ -240,8 +287,8 @@ pub(super) struct ChunkTaps {
     /// right one, two unused lanes) at fx = 0, and their change per unit of fx: the weights
     /// are `lo + fx · d` = [(1 − fx)·wt, fx·wt, 0, 0]. Runtime arrays, so the compiler keeps
     /// the 8-lane arithmetic whole instead of folding the constant lanes.
-    rot_lo: Vec<[f32; 8]>,
-    rot_d: Vec<[f32; 8]>,
+    pub(super) rot_lo: Vec<[f32; 8]>,
+    pub(super) rot_d: Vec<[f32; 8]>,
     /// Largest |offset| (mm) of the axis-aligned taps.
     axis_mm: f32,
     /// Largest |offset| (mm) of the rotated taps (0 without jitter).
@@ -288,6 +335,9 @@ pub(super) struct Ctx<'a> {
     pub summary: &'a Summary,
     pub table: &'a PixelTable,
     pub taps: &'a ChunkTaps,
+    /// The same taps for the AVX2 group loop.
+    #[cfg(target_arch = "x86_64")]
+    pub groups: &'a super::groups::GroupTaps,
     /// Use the x86-64 baseline code even where AVX2 is available (to test it).
     pub baseline: bool,
 }
@@ -300,7 +350,9 @@ pub(super) struct Lanes {
     /// x coordinate.
     px: [f32; CHUNK],
     /// 1 / mm_per_pixel.
-    inv: [f32; CHUNK],
+    pub(super) inv: [f32; CHUNK],
+    /// The horizontal pass's source row padded by its edge pixels (AVX2 build).
+    padrow: Vec<f32>,
     /// An axis tap's fractional position per pixel, and the same repeated over the channels.
     frac: [f32; CHUNK],
     frac3: [f32; FLOATS],
@@ -354,6 +406,7 @@ impl Lanes {
 
             j: [[0; CHUNK]; 4],
             acc: [0.0; FLOATS],
+            padrow: Vec::new(),
         })
     }
 }
@@ -385,9 +438,10 @@ pub(super) fn row<const VERTICAL: bool, const JITTER: bool>(
     row_any::<VERTICAL, JITTER, Separate>(pass, ctx, lanes, y, out)
 }
 
-/// [`row_any`] compiled for AVX2 and FMA: twice the vector width of the x86-64 baseline
-/// (SSE2), and each multiply-add fused ([`Fused`]), so its results differ from the baseline
-/// build's by rounding (a few units in the last place of each sum).
+/// [`row_any`] compiled for AVX2 and FMA: the chunks that pass the test are summed by
+/// [`super::groups::chunk`] (multiply-adds fused, so its results differ from the baseline
+/// build's by rounding: a few units in the last place of each sum), the rest as in the
+/// baseline build.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn row_avx2<const VERTICAL: bool, const JITTER: bool>(
@@ -455,11 +509,44 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     mut out: RowOut,
 ) -> usize {
     let w = pass.input.width;
+    #[cfg(target_arch = "x86_64")]
+    let mut padrow = std::mem::take(&mut lanes.padrow);
+    #[cfg(target_arch = "x86_64")]
+    let pad = if A::AVX2 && !VERTICAL {
+        let pad = row_reach(ctx, y);
+        super::groups::pad_row(pass.src.as_flattened(), w, y, pad, &mut padrow);
+        pad
+    } else {
+        0
+    };
+    // A chunk of `n` pixels from `x0` through the fast path, if it passes the test.
+    let fast_chunk = |lanes: &mut Lanes, out: &mut RowOut, x0: usize, n: usize| {
+        #[cfg(target_arch = "x86_64")]
+        if A::AVX2 {
+            if !eligible::<VERTICAL, JITTER>(pass, ctx, x0, y, n) {
+                return false;
+            }
+            let srcs = super::groups::Sources {
+                src: pass.src.as_flattened(),
+                row: &padrow,
+                pad,
+            };
+            // SAFETY: `A::AVX2` is only true for `Fused`, which only `row_avx2` uses, after
+            // checking that the CPU has AVX2 and FMA.
+            unsafe { super::groups::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out) };
+            return true;
+        }
+        if chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, x0, y, n) {
+            store(out, &lanes.acc[..3 * n], x0);
+            true
+        } else {
+            false
+        }
+    };
     let (mut x0, mut fast) = (0, 0);
     while x0 < w {
         let n = CHUNK.min(w - x0);
-        if chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, x0, y, n) {
-            store(&mut out, &lanes.acc[..3 * n], x0);
+        if fast_chunk(lanes, &mut out, x0, n) {
             fast += n;
         } else {
             // Near a silhouette: retry in smaller pieces (each reaches less far across the
@@ -467,8 +554,7 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
             let mut s0 = x0;
             while s0 < x0 + n {
                 let k = SUBCHUNK.min(x0 + n - s0);
-                if chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, s0, y, k) {
-                    store(&mut out, &lanes.acc[..3 * k], s0);
+                if fast_chunk(lanes, &mut out, s0, k) {
                     fast += k;
                 } else {
                     for x in s0..s0 + k {
@@ -481,7 +567,21 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
         }
         x0 += n;
     }
+    #[cfg(target_arch = "x86_64")]
+    {
+        lanes.padrow = padrow;
+    }
     fast
+}
+
+/// How far (pixels) the axis taps of row `y`'s blurred pixels reach along the row, plus
+/// the bilinear neighbour and a margin for the group loop's three runs (capped: a group
+/// whose reads pass the padding goes pixel by pixel).
+#[cfg(target_arch = "x86_64")]
+fn row_reach(ctx: &Ctx, y: usize) -> usize {
+    let inv_max = ctx.summary.row_inv_max(y);
+    let reach = (ctx.taps.axis_mm * inv_max).ceil() + 4.0;
+    if reach < 4096.0 { reach as usize } else { 4096 }
 }
 
 /// Writes (or adds) the RGB values `v` at pixel `x0` of the output row.
@@ -571,6 +671,24 @@ fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     y: usize,
     n: usize,
 ) -> bool {
+    if !eligible::<VERTICAL, JITTER>(pass, ctx, x0, y, n) {
+        return false;
+    }
+    sum_chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, x0, y, n);
+    true
+}
+
+/// Whether the `n` pixels of row `y` from column `x0` can take the fast path: all blurred,
+/// one object, and every texel their taps can reach kept (the silhouette test, hoisted into
+/// the [`Summary`]).
+#[inline(always)]
+fn eligible<const VERTICAL: bool, const JITTER: bool>(
+    pass: &Pass,
+    ctx: &Ctx,
+    x0: usize,
+    y: usize,
+    n: usize,
+) -> bool {
     let inp = pass.input;
     let (w, h) = (inp.width, inp.height);
     let i0 = y * w + x0;
@@ -578,22 +696,11 @@ fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     if id == NO_OBJECT || w + h >= SMALL {
         return false;
     }
-    // Every pixel blurred (an integer OR fold rather than an early exit, so the loop
-    // vectorises).
-    let mut skipped = 0u32;
-    for (v, &mm) in lanes.inv[..n].iter_mut().zip(&inp.mm_per_pixel[i0..i0 + n]) {
-        let (inv, ok) = pass.rules.inverse_scale_lane(mm);
-        *v = inv;
-        skipped |= u32::from(!ok);
-    }
-    let inv_max = lanes.inv[..n].iter().fold(0.0f32, |a, &v| a.max(v));
-    // One object with finite depths over the chunk's own cells, and their depth range.
-    let Some((dmin0, dmax0)) = ctx.summary.range(id, y, (x0, x0 + n - 1)) else {
+    // One object with finite depths over the chunk's own cells, every pixel blurred; their
+    // depth range and largest inverse footprint.
+    let Some((dmin0, dmax0, inv_max)) = ctx.summary.range(id, y, (x0, x0 + n - 1)) else {
         return false;
     };
-    if skipped != 0 {
-        return false;
-    }
 
     // The rectangle every tap of every pixel can read (pixels; +2 covers the bilinear
     // neighbour and rounding), clamped to the image as the reads are.
@@ -620,10 +727,27 @@ fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     let thr = pass.rules.depth_mm;
     let margin = (dmin0.abs() + dmax0.abs() + thr) * (1.0 / 1_048_576.0);
     let (lo, hi) = (dmax0 - thr + margin, dmin0 + thr - margin);
-    if !ctx.summary.clean(id, ys, xs, lo, hi) {
-        return false;
-    }
+    ctx.summary.clean(id, ys, xs, lo, hi)
+}
 
+/// The taps of a chunk that passed [`eligible`], summed into `lanes.acc` (the portable
+/// form).
+#[inline(always)]
+fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
+    pass: &Pass,
+    ctx: &Ctx,
+    lanes: &mut Lanes,
+    x0: usize,
+    y: usize,
+    n: usize,
+) {
+    let inp = pass.input;
+    let (w, h) = (inp.width, inp.height);
+    let i0 = y * w + x0;
+    let taps = ctx.taps;
+    for (v, &mm) in lanes.inv[..n].iter_mut().zip(&inp.mm_per_pixel[i0..i0 + n]) {
+        *v = pass.rules.inverse_scale_lane(mm).0;
+    }
     // Every texel is kept: the taps in order, as `Pass::pixel_fast` sums them.
     let src = pass.src.as_flattened();
     let m = 3 * n;
@@ -639,7 +763,7 @@ fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
         // applied as an added product: x − o·(−s) = x + o·s, the same bits).
         let rot = &ctx.table.rotation[i0..i0 + n];
         for l in 0..n {
-            let (c, s) = pass.rotations[rot[l] as usize];
+            let [c, s] = pass.rotations[rot[l] as usize];
             (lanes.rdx[l], lanes.rdy[l]) = if VERTICAL { (s, c) } else { (c, s) };
         }
     }
@@ -786,7 +910,6 @@ fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     if inside > 0 {
         rotated_sums::<A>(lanes, taps, src, w, n, inside);
     }
-    true
 }
 
 /// Adds the first `inside` rotated taps held in `lanes` (cells inside the image) to the
@@ -814,29 +937,6 @@ fn rotated_sums<A: MulAdd>(
     );
     let rtap = &lanes.rtap[..inside];
     let rot3 = &mut lanes.rot3;
-    #[cfg(target_arch = "x86_64")]
-    if A::AVX2 {
-        let mut w8: [RowWeights; ROTATED] = [([0.0; 8], [0.0; 8]); ROTATED];
-        for (q, &k) in rtap.iter().enumerate() {
-            w8[q] = (taps.rot_lo[k], taps.rot_d[k]);
-        }
-        // SAFETY: `A::AVX2` is only true for `Fused`, which only `row_avx2` uses, after
-        // checking that the CPU has AVX2 and FMA.
-        unsafe {
-            rotated_pixels_avx2(
-                (&lanes.rj, &lanes.rfx, &lanes.rfy),
-                (&w8, inside),
-                src,
-                down,
-                rot3,
-                n,
-            )
-        };
-        for i in 0..3 * n {
-            lanes.acc[i] += lanes.rot3[i];
-        }
-        return;
-    }
     for l in 0..n {
         let mut r = [0.0f32; 8];
         for q in 0..inside {
@@ -903,67 +1003,4 @@ fn rotated_cells<const VERTICAL: bool, A: MulAdd>(
         rj[l] = bits(cx).wrapping_add(bits(cy).wrapping_mul(w as u32));
     }
     edge != 0
-}
-
-/// The per-pixel loop of [`rotated_sums`] in AVX2 + FMA intrinsics: the same operations as the
-/// portable loop, on one 8-lane register per row (the compiler splits the portable loop's
-/// 8-float arrays into 4-lane halves with inserts and bounds checks, about twice the
-/// instructions). The reads are raw 8-float loads after one check per chunk that every one
-/// is inside `src`.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn rotated_pixels_avx2(
-    (rj, rfx, rfy): (&Slots<u32>, &Slots<f32>, &Slots<f32>),
-    (w8, inside): (&[RowWeights; ROTATED], usize),
-    src: &[f32],
-    down: usize,
-    rot3: &mut [f32; FLOATS + 1],
-    n: usize,
-) {
-    use std::arch::x86_64::*;
-    let (inside, n) = (inside.min(ROTATED), n.min(CHUNK));
-    let jmax = rj[..inside]
-        .iter()
-        .map(|r| r[..n].iter().fold(0u32, |a, &j| a.max(j)))
-        .max()
-        .unwrap_or(0);
-    let inbounds = (3 * jmax as usize)
-        .checked_add(down + 8)
-        .is_some_and(|end| end <= src.len());
-    let mut wv = [(_mm256_setzero_ps(), _mm256_setzero_ps()); ROTATED];
-    for (q, (lo, d)) in w8.iter().enumerate() {
-        // SAFETY: each array holds 8 floats.
-        wv[q] = unsafe { (_mm256_loadu_ps(lo.as_ptr()), _mm256_loadu_ps(d.as_ptr())) };
-    }
-    let fold = _mm256_setr_epi32(3, 4, 5, 6, 7, 7, 7, 7);
-    let base = src.as_ptr();
-    for l in 0..n {
-        let mut r = _mm256_setzero_ps();
-        for q in 0..inside {
-            let j = 3 * rj[q][l] as usize;
-            let (a, b) = if inbounds {
-                // SAFETY: j + down + 8 ≤ src.len() for every pixel and tap of the chunk
-                // (`inbounds`).
-                unsafe {
-                    (
-                        _mm256_loadu_ps(base.add(j)),
-                        _mm256_loadu_ps(base.add(j + down)),
-                    )
-                }
-            } else {
-                let (a, b) = (load8(src, j), load8(src, j + down));
-                // SAFETY: local arrays of 8 floats.
-                unsafe { (_mm256_loadu_ps(a.as_ptr()), _mm256_loadu_ps(b.as_ptr())) }
-            };
-            let v = _mm256_fmadd_ps(_mm256_set1_ps(rfy[q][l]), _mm256_sub_ps(b, a), a);
-            let x = _mm256_fmadd_ps(_mm256_set1_ps(rfx[q][l]), wv[q].1, wv[q].0);
-            r = _mm256_fmadd_ps(x, v, r);
-        }
-        // Lanes 0..3 + lanes 3..6: RGB of the left column plus the right one (the fourth
-        // float, overwritten by the next pixel's, is unused).
-        let sum = _mm256_add_ps(r, _mm256_permutevar8x32_ps(r, fold));
-        let out = &mut rot3[3 * l..3 * l + 4];
-        // SAFETY: `out` holds 4 floats.
-        unsafe { _mm_storeu_ps(out.as_mut_ptr(), _mm256_castps256_ps128(sum)) };
-    }
 }

@@ -1,0 +1,601 @@
+//! The fast path of the row-chunked pass in AVX2 + FMA intrinsics: a chunk that passed the
+//! silhouette test of [`super::rows`] is summed in groups of 8 pixels, with every tap of the
+//! pass applied to the group while its sums stay in three registers (the group's 24 floats
+//! of RGB).
+//!
+//! Per group and tap, as [`super::pixel::Pass::pixel`] computes them, with the same f32
+//! operations (so the same positions and fractions, bit for bit):
+//! - an axis-aligned tap computes the 8 pixels' positions in one register, then their
+//!   fractions are spread over the channels with three permutes. When the 8 pixels share
+//!   their integer offset (the footprint changes slowly), the tap blends two unaligned
+//!   runs of 24 floats; when the offset takes two neighbouring values within the group,
+//!   three runs, each pixel blending the first two or the last two (a per-lane select);
+//!   else the group goes pixel by pixel. The horizontal pass reads a copy of the source row
+//!   padded on both sides by its edge pixels (the clamp to the edge, done once per row), the
+//!   vertical pass reads whole source rows whose index is clamped once per tap;
+//! - the centre tap reads the group's own 24 floats;
+//! - a rotated (jittered) tap is a bilinear read at each pixel's own angle: the positions
+//!   and cells of the 8 pixels are computed in registers, then each pixel reads its cell's
+//!   two rows as two 8-float loads (the cell's two texels are six contiguous floats), blends
+//!   them along y, weights them by [(1 − fx)·w, fx·w] and adds them up over the rotated taps;
+//!   the sums are added after the other taps. A tap whose cells reach the image border
+//!   reads each pixel's four texels clamped to the image instead.
+//!
+//! The rounding differs from the per-pixel form's (fused multiply-adds, rotated taps summed
+//! last), within the tolerance stated in [`super`].
+
+use super::pixel::Pass;
+use super::rows::{ChunkTaps, Ctx, RowOut};
+use std::arch::x86_64::*;
+
+/// Pixels per group (one 8-lane register per channel triple of floats).
+const G: usize = 8;
+/// Rotated taps whose positions a group holds at once (more are summed in batches).
+const HELD: usize = 4;
+
+/// The pass's taps as the group loop uses them, by kind (the centre tap, the axis-aligned
+/// ones, the rotated ones), each with its weights laid out for the group's registers.
+pub(super) struct GroupTaps {
+    /// Offset-0 taps: their weights over a group's 24 floats (RGB repeated).
+    centre: Vec<[f32; 3 * G]>,
+    /// Axis-aligned taps: offset (mm) and weights over the 24 floats.
+    axis: Vec<(f32, [f32; 3 * G])>,
+    /// Rotated taps: offset (mm) and their row-pair weights at fx = 0 and their change per
+    /// unit of fx (see [`ChunkTaps`]).
+    rotated: Vec<(f32, [f32; 8], [f32; 8])>,
+}
+
+impl GroupTaps {
+    /// The layout of `pass`'s taps (`taps` is the same pass's chunk layout).
+    pub fn new(pass: &Pass, taps: &ChunkTaps) -> GroupTaps {
+        let t = pass.taps;
+        let mut g = GroupTaps {
+            centre: Vec::new(),
+            axis: Vec::new(),
+            rotated: Vec::new(),
+        };
+        for (k, (&o, w)) in t.offset.iter().zip(&t.weight).enumerate() {
+            let w24: [f32; 3 * G] = std::array::from_fn(|i| w[i % 3]);
+            if o == 0.0 {
+                g.centre.push(w24);
+            } else if pass.jitter && o.abs() <= pass.rotate_limit_mm {
+                g.rotated.push((o, taps.rot_lo[k], taps.rot_d[k]));
+            } else {
+                g.axis.push((o, w24));
+            }
+        }
+        g
+    }
+}
+
+/// The horizontal pass's source row `y`, padded on each side by `pad` copies of its edge
+/// pixel (so reads up to `pad` pixels past either end are the clamped ones), RGB.
+pub(super) fn pad_row(src: &[f32], w: usize, y: usize, pad: usize, row: &mut Vec<f32>) {
+    let s = &src[3 * y * w..3 * (y + 1) * w];
+    row.resize(3 * (w + 2 * pad), 0.0);
+    let (left, rest) = row.split_at_mut(3 * pad);
+    let (middle, right) = rest.split_at_mut(3 * w);
+    middle.copy_from_slice(s);
+    for p in left.chunks_exact_mut(3) {
+        p.copy_from_slice(&s[..3]);
+    }
+    for p in right.chunks_exact_mut(3) {
+        p.copy_from_slice(&s[3 * w - 3..]);
+    }
+}
+
+/// 8 floats of `s` from `i` (bounds-checked).
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn load(s: &[f32], i: usize) -> __m256 {
+    let v: &[f32; 8] = s[i..i + 8].try_into().expect("8 floats");
+    // SAFETY: `v` holds 8 floats.
+    unsafe { _mm256_loadu_ps(v.as_ptr()) }
+}
+
+/// The 24 floats of `s` from `i` as three registers (one bounds check).
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn load24(s: &[f32], i: usize) -> [__m256; 3] {
+    let v: &[f32; 24] = s[i..i + 24].try_into().expect("24 floats");
+    // SAFETY: `v` holds 24 floats.
+    unsafe {
+        [
+            _mm256_loadu_ps(v.as_ptr()),
+            _mm256_loadu_ps(v.as_ptr().add(8)),
+            _mm256_loadu_ps(v.as_ptr().add(16)),
+        ]
+    }
+}
+
+/// Per-pixel lanes repeated over the three channels: 8 pixels → 24 floats.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn spread(v: __m256) -> [__m256; 3] {
+    [
+        perm(v, [0, 0, 0, 1, 1, 1, 2, 2]),
+        perm(v, [2, 3, 3, 3, 4, 4, 4, 5]),
+        perm(v, [5, 5, 6, 6, 6, 7, 7, 7]),
+    ]
+}
+
+/// The smallest and largest of 8 integer lanes.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn min_max(v: __m256i) -> (i32, i32) {
+    let swap = _mm256_permute2x128_si256::<1>(v, v);
+    let (mut lo, mut hi) = (_mm256_min_epi32(v, swap), _mm256_max_epi32(v, swap));
+    lo = _mm256_min_epi32(lo, _mm256_shuffle_epi32::<0b01_00_11_10>(lo));
+    hi = _mm256_max_epi32(hi, _mm256_shuffle_epi32::<0b01_00_11_10>(hi));
+    lo = _mm256_min_epi32(lo, _mm256_shuffle_epi32::<0b10_11_00_01>(lo));
+    hi = _mm256_max_epi32(hi, _mm256_shuffle_epi32::<0b10_11_00_01>(hi));
+    (_mm256_cvtsi256_si32(lo), _mm256_cvtsi256_si32(hi))
+}
+
+/// Where a group's rows come from.
+pub(super) struct Sources<'a> {
+    /// The pass's source image (RGB, row-major).
+    pub src: &'a [f32],
+    /// The horizontal pass's padded source row ([`pad_row`]) and its padding (pixels).
+    pub row: &'a [f32],
+    pub pad: usize,
+}
+
+/// Groups in a chunk, at most.
+const GROUPS: usize = super::rows::CHUNK / G;
+
+/// 24 floats from `p` as three registers.
+///
+/// # Safety
+/// `p .. p + 24` must be readable.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn load24_at(p: *const f32) -> [__m256; 3] {
+    // SAFETY: the caller's.
+    unsafe {
+        [
+            _mm256_loadu_ps(p),
+            _mm256_loadu_ps(p.add(8)),
+            _mm256_loadu_ps(p.add(16)),
+        ]
+    }
+}
+
+/// Sums the `n` pixels of row `y` from column `x0` (a chunk that passed the silhouette test)
+/// into `out`: whole groups of 8 here, the
+/// rest (and any group the registers cannot take) pixel by pixel.
+///
+/// The taps are the outer loop and the groups the inner one, so that what a tap needs once
+/// per chunk (its integer offset when the chunk's pixels share it, and where its runs start)
+/// is found once: the centre tap, then each axis tap, then the rotated taps.
+#[target_feature(enable = "avx2,fma")]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn chunk<const VERTICAL: bool, const JITTER: bool>(
+    pass: &Pass,
+    ctx: &Ctx,
+    srcs: &Sources,
+    x0: usize,
+    y: usize,
+    n: usize,
+    out: &mut RowOut,
+) {
+    let groups = (n / G).min(GROUPS);
+    let gt = ctx.groups;
+    let (w, h) = (pass.input.width, pass.input.height);
+    let src = srcs.src;
+    let iota = _mm256_setr_ps(0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0);
+    let yv = _mm256_set1_ps(y as f32);
+    let mm = &pass.input.mm_per_pixel[y * w + x0..y * w + x0 + G * groups];
+    let mut inv = [_mm256_setzero_ps(); GROUPS];
+    let mut along = [yv; GROUPS];
+    for g in 0..groups {
+        // 1 / mm_per_pixel, as `Rules::inverse_scale_lane` computes it.
+        inv[g] = _mm256_div_ps(_mm256_set1_ps(1.0), load(mm, G * g));
+        if !VERTICAL {
+            along[g] = _mm256_add_ps(_mm256_set1_ps((x0 + G * g) as f32), iota);
+        }
+    }
+    let mut acc = [[_mm256_setzero_ps(); 3]; GROUPS];
+    // Groups that go pixel by pixel (one bit each).
+    let mut failed = 0u32;
+    // The horizontal pass reads its padded row, the vertical one the image.
+    let from = if VERTICAL { src } else { srcs.row };
+    let last_row = h as i32 - 1;
+
+    for wt in &gt.centre {
+        let wv = [load(wt, 0), load(wt, 8), load(wt, 16)];
+        let start = if VERTICAL {
+            3 * (y * w + x0)
+        } else {
+            3 * (srcs.pad + x0)
+        };
+        let run = &from[start..start + 3 * G * groups];
+        for g in 0..groups {
+            // SAFETY: `run` holds 24 floats per group.
+            let s = unsafe { load24_at(run.as_ptr().add(3 * G * g)) };
+            for i in 0..3 {
+                acc[g][i] = _mm256_fmadd_ps(wv[i], s[i], acc[g][i]);
+            }
+        }
+    }
+
+    for (o_mm, wt) in &gt.axis {
+        // Per pixel: p = x − o (or y − o), its floor p0 and fraction, as the per-pixel form
+        // computes them, and the offset p0 − x of the pixel from its own column (or row).
+        let o = _mm256_set1_ps(*o_mm);
+        let mut frac = [_mm256_setzero_ps(); GROUPS];
+        let mut key = [_mm256_setzero_si256(); GROUPS];
+        let (mut lo, mut hi) = (_mm256_set1_epi32(i32::MAX), _mm256_set1_epi32(i32::MIN));
+        for g in 0..groups {
+            let p = _mm256_sub_ps(along[g], _mm256_mul_ps(o, inv[g]));
+            let p0 = _mm256_floor_ps(p);
+            frac[g] = _mm256_sub_ps(p, p0);
+            key[g] = _mm256_cvttps_epi32(_mm256_sub_ps(p0, along[g]));
+            lo = _mm256_min_epi32(lo, key[g]);
+            hi = _mm256_max_epi32(hi, key[g]);
+        }
+        let wv = [load(wt, 0), load(wt, 8), load(wt, 16)];
+        let (c, _) = min_max(lo);
+        let (_, top) = min_max(hi);
+        // One offset over the chunk: two runs, each read once per group.
+        let runs = if c != top {
+            None
+        } else if VERTICAL {
+            let row = |t: i32| 3 * ((y as i32 + c + t).clamp(0, last_row) as usize * w + x0);
+            Some((row(0), row(1)))
+        } else {
+            let start = srcs.pad as isize + x0 as isize + c as isize;
+            (start >= 0 && start as usize + G * groups < srcs.row.len() / 3)
+                .then(|| (3 * start as usize, 3 * start as usize + 3))
+        };
+        if let Some((r0, r1)) = runs {
+            let (a0, a1) = (
+                &from[r0..r0 + 3 * G * groups],
+                &from[r1..r1 + 3 * G * groups],
+            );
+            for g in 0..groups {
+                // SAFETY: each run holds 24 floats per group.
+                let (a, b) = unsafe {
+                    (
+                        load24_at(a0.as_ptr().add(3 * G * g)),
+                        load24_at(a1.as_ptr().add(3 * G * g)),
+                    )
+                };
+                let f = spread(frac[g]);
+                for i in 0..3 {
+                    let v = _mm256_fmadd_ps(f[i], _mm256_sub_ps(b[i], a[i]), a[i]);
+                    acc[g][i] = _mm256_fmadd_ps(wv[i], v, acc[g][i]);
+                }
+            }
+            continue;
+        }
+        // The offset changes across the chunk: each group on its own, with the runs at
+        // offsets lo and lo + 1 (and lo + 2), each pixel blending the first two or the last
+        // two; a group whose offsets span more than two values goes pixel by pixel.
+        for g in 0..groups {
+            let (lo, hi) = min_max(key[g]);
+            if hi - lo > 1 {
+                failed |= 1 << g;
+                continue;
+            }
+            let xg = x0 + G * g;
+            let r: [usize; 3] = if VERTICAL {
+                let row = |t: i32| 3 * ((y as i32 + lo + t).clamp(0, last_row) as usize * w + xg);
+                [row(0), row(1), row(2)]
+            } else {
+                let start = srcs.pad as isize + xg as isize + lo as isize;
+                if start < 0 || start as usize + G + 2 > srcs.row.len() / 3 {
+                    failed |= 1 << g;
+                    continue;
+                }
+                let s = 3 * start as usize;
+                [s, s + 3, s + 6]
+            };
+            let (a, b, c) = (load24(from, r[0]), load24(from, r[1]), load24(from, r[2]));
+            let up = _mm256_castsi256_ps(_mm256_cmpgt_epi32(key[g], _mm256_set1_epi32(lo)));
+            let m = spread(up);
+            let f = spread(frac[g]);
+            for i in 0..3 {
+                let (a, b) = (
+                    _mm256_blendv_ps(a[i], b[i], m[i]),
+                    _mm256_blendv_ps(b[i], c[i], m[i]),
+                );
+                let v = _mm256_fmadd_ps(f[i], _mm256_sub_ps(b, a), a);
+                acc[g][i] = _mm256_fmadd_ps(wv[i], v, acc[g][i]);
+            }
+        }
+    }
+
+    if JITTER && !gt.rotated.is_empty() {
+        for g in 0..groups {
+            if failed & (1 << g) != 0 {
+                continue;
+            }
+            let r = rotated::<VERTICAL>(pass, ctx, inv[g], src, x0 + G * g, y);
+            for i in 0..3 {
+                acc[g][i] = _mm256_add_ps(acc[g][i], r[i]);
+            }
+        }
+    }
+
+    for (g, acc) in acc.iter().enumerate().take(groups) {
+        let xg = x0 + G * g;
+        if failed & (1 << g) != 0 {
+            pixels::<VERTICAL, JITTER>(pass, xg, xg + G, y, out);
+            continue;
+        }
+        let dst: &mut [f32; 24] = (&mut out.row[3 * xg..3 * xg + 3 * G])
+            .try_into()
+            .expect("24 floats");
+        let p = dst.as_mut_ptr();
+        // SAFETY: `dst` holds 24 floats.
+        unsafe {
+            for (i, a) in acc.iter().enumerate() {
+                let v = if out.accumulate {
+                    _mm256_add_ps(_mm256_loadu_ps(p.add(8 * i)), *a)
+                } else {
+                    *a
+                };
+                _mm256_storeu_ps(p.add(8 * i), v);
+            }
+        }
+    }
+    pixels::<VERTICAL, JITTER>(pass, x0 + G * groups, x0 + n, y, out);
+}
+
+/// Pixels `a..b` of row `y` through the per-pixel form.
+#[inline(never)]
+fn pixels<const VERTICAL: bool, const JITTER: bool>(
+    pass: &Pass,
+    a: usize,
+    b: usize,
+    y: usize,
+    out: &mut RowOut,
+) {
+    for x in a..b {
+        let v = pass.pixel::<VERTICAL, JITTER>(x, y);
+        let d = &mut out.row[3 * x..3 * x + 3];
+        for c in 0..3 {
+            d[c] = if out.accumulate { d[c] + v[c] } else { v[c] };
+        }
+    }
+}
+
+/// The rotated taps of the group at `xg`: each pixel's bilinear reads along its own rotated
+/// axis, summed per pixel (the cell's two rows as 8-float loads: RGB of the left texel, of
+/// the right one, two spare floats; blended along y, weighted by [(1 − fx)·w, fx·w, 0, 0]).
+/// A tap whose cells reach the image border reads each pixel's four clamped texels.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn rotated<const VERTICAL: bool>(
+    pass: &Pass,
+    ctx: &Ctx,
+    inv: __m256,
+    src: &[f32],
+    xg: usize,
+    y: usize,
+) -> [__m256; 3] {
+    let (w, h) = (pass.input.width, pass.input.height);
+    let iota = _mm256_setr_ps(0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0);
+    let xv = _mm256_add_ps(_mm256_set1_ps(xg as f32), iota);
+    let yv = _mm256_set1_ps(y as f32);
+    // The pixels' rotated axis (cos, sin).
+    let i0 = y * w + xg;
+    let r: &[u8; 8] = ctx.table.rotation[i0..i0 + G]
+        .try_into()
+        .expect("8 rotations");
+    let k = _mm256_cvtepu8_epi32(_mm_set_epi64x(0, i64::from_le_bytes(*r)));
+    let table = pass.rotations.as_flattened();
+    assert_eq!(table.len(), 2 * super::ROTATION_STEPS);
+    let k2 = _mm256_slli_epi32::<1>(k);
+    // SAFETY: every index is 2·k or 2·k + 1 with k < 256 = ROTATION_STEPS (a u8), into the
+    // table of ROTATION_STEPS (cos, sin) pairs.
+    let (cs, sn) = unsafe {
+        (
+            _mm256_i32gather_ps::<4>(table.as_ptr(), k2),
+            _mm256_i32gather_ps::<4>(table.as_ptr().add(1), k2),
+        )
+    };
+    assert!(src.len() >= 3 * w * h);
+    let geo = Geometry {
+        xv,
+        yv,
+        cs,
+        sn,
+        inv,
+        w,
+        h,
+    };
+    let mut rsum = [_mm256_setzero_ps(); G];
+    for batch in ctx.groups.rotated.chunks(HELD) {
+        match batch {
+            [a] => rotated_batch::<VERTICAL, 1>(&geo, [a], src, &mut rsum),
+            [a, b] => rotated_batch::<VERTICAL, 2>(&geo, [a, b], src, &mut rsum),
+            [a, b, c] => rotated_batch::<VERTICAL, 3>(&geo, [a, b, c], src, &mut rsum),
+            [a, b, c, d] => rotated_batch::<VERTICAL, 4>(&geo, [a, b, c, d], src, &mut rsum),
+            _ => unreachable!("batches of 1 to {HELD} taps"),
+        }
+    }
+    interleave(&rsum)
+}
+
+/// A group's coordinates, rotated axes and inverse footprints, and the image size.
+struct Geometry {
+    xv: __m256,
+    yv: __m256,
+    cs: __m256,
+    sn: __m256,
+    inv: __m256,
+    w: usize,
+    h: usize,
+}
+
+/// Adds `NQ` rotated taps to each pixel's 8-lane sum in `rsum` (see [`rotated`]).
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
+    geo: &Geometry,
+    taps: [&(f32, [f32; 8], [f32; 8]); NQ],
+    src: &[f32],
+    rsum: &mut [__m256; G],
+) {
+    let (w, h) = (geo.w, geo.h);
+    let zero = _mm256_setzero_ps();
+    let (xmax, ymax) = (
+        _mm256_set1_ps(w as f32 - 3.0),
+        _mm256_set1_ps(h as f32 - 2.0),
+    );
+    let wi = _mm256_set1_epi32(w as i32);
+    let down = 3 * w;
+    let base = src.as_ptr();
+    // Per tap, in registers: each pixel's cell (its first float, for taps inside the image)
+    // and bilinear fractions (lanes are taken out of the registers rather than stored and
+    // read back as scalars: a narrow load of a wide store just written stalls); the cells of
+    // taps that reach past the border (a bit each) as columns and rows.
+    let mut rj = [_mm256_setzero_si256(); NQ];
+    let mut rfx = [_mm256_setzero_ps(); NQ];
+    let mut rfy = [_mm256_setzero_ps(); NQ];
+    let mut rcx = [[0i32; G]; NQ];
+    let mut rcy = [[0i32; G]; NQ];
+    let mut edge = 0u32;
+    for q in 0..NQ {
+        let o = _mm256_mul_ps(_mm256_set1_ps(taps[q].0), geo.inv);
+        // x − o·c, y − o·s (horizontal); x + o·s, y − o·c (vertical: the axis is (−s, c)),
+        // with the per-pixel form's roundings.
+        let (sx, sy) = if VERTICAL {
+            (
+                _mm256_add_ps(geo.xv, _mm256_mul_ps(o, geo.sn)),
+                _mm256_sub_ps(geo.yv, _mm256_mul_ps(o, geo.cs)),
+            )
+        } else {
+            (
+                _mm256_sub_ps(geo.xv, _mm256_mul_ps(o, geo.cs)),
+                _mm256_sub_ps(geo.yv, _mm256_mul_ps(o, geo.sn)),
+            )
+        };
+        let (cx, cy) = (_mm256_floor_ps(sx), _mm256_floor_ps(sy));
+        rfx[q] = _mm256_sub_ps(sx, cx);
+        rfy[q] = _mm256_sub_ps(sy, cy);
+        // Inside: 0 ≤ cx ≤ w − 3 (the 8-float loads read one pixel past the cell) and
+        // 0 ≤ cy ≤ h − 2 (positions are finite: inv and the offsets are).
+        let outside = _mm256_or_ps(
+            _mm256_or_ps(
+                _mm256_cmp_ps::<_CMP_LT_OQ>(cx, zero),
+                _mm256_cmp_ps::<_CMP_GT_OQ>(cx, xmax),
+            ),
+            _mm256_or_ps(
+                _mm256_cmp_ps::<_CMP_LT_OQ>(cy, zero),
+                _mm256_cmp_ps::<_CMP_GT_OQ>(cy, ymax),
+            ),
+        );
+        let (cxi, cyi) = (_mm256_cvttps_epi32(cx), _mm256_cvttps_epi32(cy));
+        let j = _mm256_add_epi32(cxi, _mm256_mullo_epi32(cyi, wi));
+        rj[q] = _mm256_add_epi32(j, _mm256_add_epi32(j, j));
+        if _mm256_movemask_ps(outside) != 0 {
+            edge |= 1 << q;
+            // SAFETY: each destination holds 8 lanes.
+            unsafe {
+                _mm256_storeu_si256(rcx[q].as_mut_ptr().cast(), cxi);
+                _mm256_storeu_si256(rcy[q].as_mut_ptr().cast(), cyi);
+            }
+        }
+    }
+    let mut lo = [_mm256_setzero_ps(); NQ];
+    let mut d = [_mm256_setzero_ps(); NQ];
+    for q in 0..NQ {
+        lo[q] = load(&taps[q].1, 0);
+        d[q] = load(&taps[q].2, 0);
+    }
+    for (l, r) in rsum.iter_mut().enumerate() {
+        let lane = _mm256_set1_epi32(l as i32);
+        for q in 0..NQ {
+            let (a, b) = if edge & (1 << q) == 0 {
+                let j = _mm_cvtsi128_si32(_mm256_castsi256_si128(_mm256_permutevar8x32_epi32(
+                    rj[q], lane,
+                ))) as usize;
+                // SAFETY: the cell (cx, cy) was checked inside the image with 0 ≤ cx ≤ w − 3
+                // and 0 ≤ cy ≤ h − 2, so j = 3·(cy·w + cx) and the 8 floats from j + 3w end
+                // at 3·((cy + 1)·w + cx) + 8 ≤ 3·w·h − 1 < src.len().
+                unsafe {
+                    (
+                        _mm256_loadu_ps(base.add(j)),
+                        _mm256_loadu_ps(base.add(j + down)),
+                    )
+                }
+            } else {
+                // Near the border: the four texels clamped to the image, as the per-pixel
+                // form reads them.
+                let (cx, cy) = (rcx[q][l], rcy[q][l]);
+                let col = |c: i32| c.clamp(0, w as i32 - 1) as usize;
+                let row = |c: i32| c.clamp(0, h as i32 - 1) as usize * w;
+                let pick = |r: usize| {
+                    let mut v = [0.0f32; 8];
+                    let (t0, t1) = (3 * (r + col(cx)), 3 * (r + col(cx + 1)));
+                    v[..3].copy_from_slice(&src[t0..t0 + 3]);
+                    v[3..6].copy_from_slice(&src[t1..t1 + 3]);
+                    v
+                };
+                (load(&pick(row(cy)), 0), load(&pick(row(cy + 1)), 0))
+            };
+            let fy = _mm256_permutevar8x32_ps(rfy[q], lane);
+            let fx = _mm256_permutevar8x32_ps(rfx[q], lane);
+            let v = _mm256_fmadd_ps(fy, _mm256_sub_ps(b, a), a);
+            let x = _mm256_fmadd_ps(fx, d[q], lo[q]);
+            *r = _mm256_fmadd_ps(x, v, *r);
+        }
+    }
+}
+
+/// The 8 pixels' rotated sums as the group's 24 floats of RGB: each pixel's left texel
+/// (lanes 0..3) plus its right one (lanes 3..6), then the pixels' triples packed in order,
+/// in registers.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn interleave(rsum: &[__m256; G]) -> [__m256; 3] {
+    let fold = _mm256_setr_epi32(3, 4, 5, 6, 7, 7, 7, 7);
+    let mut s = [_mm256_setzero_ps(); G];
+    for l in 0..G {
+        s[l] = _mm256_add_ps(rsum[l], _mm256_permutevar8x32_ps(rsum[l], fold));
+    }
+    // Pairs of pixels: [R G B · R' G' B' ·].
+    let (t01, t23, t45, t67) = (
+        pair(s[0], s[1]),
+        pair(s[2], s[3]),
+        pair(s[4], s[5]),
+        pair(s[6], s[7]),
+    );
+    [
+        // R0 G0 B0 R1 G1 B1 R2 G2
+        _mm256_blend_ps::<0b1100_0000>(
+            perm(t01, [0, 1, 2, 4, 5, 6, 0, 0]),
+            perm(t23, [0, 0, 0, 0, 0, 0, 0, 1]),
+        ),
+        // B2 R3 G3 B3 R4 G4 B4 R5
+        _mm256_blend_ps::<0b1111_0000>(
+            perm(t23, [2, 4, 5, 6, 0, 0, 0, 0]),
+            perm(t45, [0, 0, 0, 0, 0, 1, 2, 4]),
+        ),
+        // G5 B5 R6 G6 B6 R7 G7 B7
+        _mm256_blend_ps::<0b1111_1100>(
+            perm(t45, [5, 6, 0, 0, 0, 0, 0, 0]),
+            perm(t67, [0, 0, 0, 1, 2, 4, 5, 6]),
+        ),
+    ]
+}
+
+/// [a₀..a₄, b₀..b₄].
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn pair(a: __m256, b: __m256) -> __m256 {
+    _mm256_insertf128_ps::<1>(a, _mm256_castps256_ps128(b))
+}
+
+/// The lanes of `v` picked by `i`.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn perm(v: __m256, i: [i32; 8]) -> __m256 {
+    _mm256_permutevar8x32_ps(
+        v,
+        _mm256_setr_epi32(i[0], i[1], i[2], i[3], i[4], i[5], i[6], i[7]),
+    )
+}
