@@ -16,6 +16,8 @@
 //! to the 7-tap pass on the same crop for the ratio.
 //!
 //! Groups report pixels per second: `cargo bench -p sss-bench --bench separable -- --noplot`.
+//! After them the main cases run again in interleaved rounds and the fastest round of each is
+//! printed with its ratio to the plain floor (robust to a shared machine's steal time).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rayon::prelude::*;
