@@ -229,6 +229,37 @@ fn the_fast_path_is_taken_on_clean_frames() {
 }
 
 #[test]
+fn taps_reaching_past_the_padded_row_fall_back_per_pixel() {
+    // A frame 4200 pixels wide whose footprint is so small that the widest axis tap reaches
+    // 4150 pixels: the chunks still qualify (the reach is under width + height), but the
+    // horizontal pass pads its row by at most 4096 pixels, so the groups whose taps read past
+    // the padding (within 55 pixels of either end) must go pixel by pixel, and the rotated
+    // taps (over 1200 pixels long) reach past the frame's two rows and read clamped texels.
+    let (_, kernel) = kernels().remove(0);
+    let reach = kernel.terms[0]
+        .horizontal
+        .taps
+        .iter()
+        .map(|t| t.offset_mm.abs())
+        .fold(0.0, f64::max);
+    let mut f = Frame::flat(4200, 2, (reach / 4150.0) as f32);
+    f.set_irradiance(hash01);
+    for jitter in [0.0, 0.1] {
+        let opts = FilterOptions {
+            jitter_radius: jitter,
+            ..Default::default()
+        };
+        let fast = assert_same(
+            &f,
+            &kernel,
+            &opts,
+            &format!("reach 4150 px, jitter {jitter}"),
+        );
+        assert_eq!(fast, 1.0, "jitter {jitter}: every chunk qualifies");
+    }
+}
+
+#[test]
 fn the_benchmark_frames_filter_alike() {
     // The frame of `crates/bench/benches/separable.rs`: 1080p, one object, 0.5 mm per pixel, a
     // pore-like texture, a gentle depth ramp, default options, the 7-tap pre-integrated kernel

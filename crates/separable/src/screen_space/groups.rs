@@ -144,23 +144,6 @@ pub(super) struct Sources<'a> {
 /// Groups in a chunk, at most.
 const GROUPS: usize = super::rows::CHUNK / G;
 
-/// 24 floats from `p` as three registers.
-///
-/// # Safety
-/// `p .. p + 24` must be readable.
-#[target_feature(enable = "avx2,fma")]
-#[inline]
-unsafe fn load24_at(p: *const f32) -> [__m256; 3] {
-    // SAFETY: the caller's.
-    unsafe {
-        [
-            _mm256_loadu_ps(p),
-            _mm256_loadu_ps(p.add(8)),
-            _mm256_loadu_ps(p.add(16)),
-        ]
-    }
-}
-
 /// Sums the `n` pixels of row `y` from column `x0` (a chunk that passed the silhouette test)
 /// into `out`: whole groups of 8 here, the
 /// rest (and any group the registers cannot take) pixel by pixel.
@@ -209,10 +192,11 @@ pub(super) fn chunk<const VERTICAL: bool, const JITTER: bool>(
         } else {
             3 * (srcs.pad + x0)
         };
-        let run = &from[start..start + 3 * G * groups];
-        for g in 0..groups {
-            // SAFETY: `run` holds 24 floats per group.
-            let s = unsafe { load24_at(run.as_ptr().add(3 * G * g)) };
+        for (g, run) in from[start..start + 3 * G * groups]
+            .chunks_exact(3 * G)
+            .enumerate()
+        {
+            let s = load24(run, 0);
             for i in 0..3 {
                 acc[g][i] = _mm256_fmadd_ps(wv[i], s[i], acc[g][i]);
             }
@@ -250,17 +234,11 @@ pub(super) fn chunk<const VERTICAL: bool, const JITTER: bool>(
         };
         if let Some((r0, r1)) = runs {
             let (a0, a1) = (
-                &from[r0..r0 + 3 * G * groups],
-                &from[r1..r1 + 3 * G * groups],
+                from[r0..r0 + 3 * G * groups].chunks_exact(3 * G),
+                from[r1..r1 + 3 * G * groups].chunks_exact(3 * G),
             );
-            for g in 0..groups {
-                // SAFETY: each run holds 24 floats per group.
-                let (a, b) = unsafe {
-                    (
-                        load24_at(a0.as_ptr().add(3 * G * g)),
-                        load24_at(a1.as_ptr().add(3 * G * g)),
-                    )
-                };
+            for (g, (a, b)) in a0.zip(a1).enumerate() {
+                let (a, b) = (load24(a, 0), load24(b, 0));
                 let f = spread(frac[g]);
                 for i in 0..3 {
                     let v = _mm256_fmadd_ps(f[i], _mm256_sub_ps(b[i], a[i]), a[i]);

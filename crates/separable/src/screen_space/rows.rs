@@ -521,11 +521,11 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     };
     // A chunk of `n` pixels from `x0` through the fast path, if it passes the test.
     let fast_chunk = |lanes: &mut Lanes, out: &mut RowOut, x0: usize, n: usize| {
+        if !eligible::<VERTICAL, JITTER>(pass, ctx, x0, y, n) {
+            return false;
+        }
         #[cfg(target_arch = "x86_64")]
         if A::AVX2 {
-            if !eligible::<VERTICAL, JITTER>(pass, ctx, x0, y, n) {
-                return false;
-            }
             let srcs = super::groups::Sources {
                 src: pass.src.as_flattened(),
                 row: &padrow,
@@ -536,12 +536,9 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
             unsafe { super::groups::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out) };
             return true;
         }
-        if chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, x0, y, n) {
-            store(out, &lanes.acc[..3 * n], x0);
-            true
-        } else {
-            false
-        }
+        sum_chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, x0, y, n);
+        store(out, &lanes.acc[..3 * n], x0);
+        true
     };
     let (mut x0, mut fast) = (0, 0);
     while x0 < w {
@@ -658,24 +655,6 @@ fn load8(src: &[f32], i: usize) -> [f32; 8] {
         Some(v) => *v,
         None => std::array::from_fn(|k| src.get(i + k).copied().unwrap_or(0.0)),
     }
-}
-
-/// The fast path for the `n` pixels of row `y` from column `x0`: true with their values in
-/// `lanes.acc`, or false when the chunk needs the per-pixel path.
-#[inline(always)]
-fn chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
-    pass: &Pass,
-    ctx: &Ctx,
-    lanes: &mut Lanes,
-    x0: usize,
-    y: usize,
-    n: usize,
-) -> bool {
-    if !eligible::<VERTICAL, JITTER>(pass, ctx, x0, y, n) {
-        return false;
-    }
-    sum_chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, x0, y, n);
-    true
 }
 
 /// Whether the `n` pixels of row `y` from column `x0` can take the fast path: all blurred,
