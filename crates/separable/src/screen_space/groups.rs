@@ -1,16 +1,18 @@
 //! The fast path of the row-chunked pass in AVX2 + FMA intrinsics: a chunk that passed the
-//! silhouette test of [`super::rows`] is summed in groups of 8 pixels, with every tap of the
-//! pass applied to the group while its sums stay in three registers (the group's 24 floats
-//! of RGB).
+//! silhouette test of [`super::rows`] is summed in groups of 8 pixels, each group's sums
+//! held as three 8-lane vectors (the group's 24 floats of RGB). The taps are the outer loop
+//! and the chunk's groups the inner one, so that what a tap needs once per chunk is found
+//! once.
 //!
 //! Per group and tap, as [`super::pixel::Pass::pixel`] computes them, with the same f32
 //! operations (so the same positions and fractions, bit for bit):
 //! - an axis-aligned tap computes the 8 pixels' positions in one register, then their
-//!   fractions are spread over the channels with three permutes. When the 8 pixels share
-//!   their integer offset (the footprint changes slowly), the tap blends two unaligned
-//!   runs of 24 floats; when the offset takes two neighbouring values within the group,
-//!   three runs, each pixel blending the first two or the last two (a per-lane select);
-//!   else the group goes pixel by pixel. The horizontal pass reads a copy of the source row
+//!   fractions are spread over the channels with three permutes. When all the chunk's pixels
+//!   share their integer offset (the footprint changes slowly), each group blends its part of
+//!   two unaligned runs of the source found once for the chunk; otherwise each group reads
+//!   three runs from its own smallest offset, each pixel blending the first two or the last
+//!   two (a per-lane select), or goes pixel by pixel if its offsets span more than two
+//!   values. The horizontal pass reads a copy of the source row
 //!   padded on both sides by its edge pixels (the clamp to the edge, done once per row), the
 //!   vertical pass reads whole source rows whose index is clamped once per tap;
 //! - the centre tap reads the group's own 24 floats;

@@ -38,16 +38,17 @@
 //! on every built-in scene. Which pixels take which form depends only on the inputs, so the
 //! result is identical for any thread count.
 //!
-//! On x86-64 with AVX2 and FMA (checked at run time) the chunks run in `groups.rs`: groups of
-//! 8 pixels whose 24 sums stay in registers, taps as the outer loop so that a tap's integer
-//! offset and runs are found once per chunk, per-pixel fractions spread over the channels by
-//! permutes, rotated taps as two 8-float loads per pixel. It is written with intrinsics, and
-//! its loads from positions checked once per chunk (or per group, for the rotated taps) are
-//! `unsafe`: the portable loops (`rows.rs`, kept for other CPUs and tested against the same
-//! reference as `Evaluation::RowsBaseline`) compile to memory-resident arrays and about 1.4×
-//! the time without jitter on the benchmark frame (README). The baseline build multiplies
-//! and adds separately, so the two builds differ by rounding. Cost and its breakdown:
-//! `crates/bench/benches/separable.rs` and the README.
+//! On x86-64 with AVX2 and FMA (checked at run time) the chunks run in `groups.rs`: groups
+//! of 8 pixels whose 24 sums are three 8-lane vectors, taps as the outer loop so that a
+//! tap's integer offset and runs are found once per chunk, per-pixel fractions spread over
+//! the channels by permutes, rotated taps as two 8-float loads per pixel. It is written with
+//! intrinsics; its `unsafe` parts are the call into it after the CPU check, the gathers of
+//! the rotation table and the rotated taps' loads from cells checked inside the image once
+//! per group. The portable loops (`rows.rs`, kept for other CPUs and tested against the same
+//! reference as `Evaluation::RowsBaseline`) keep their sums in memory and, compiled for
+//! AVX2, took 1.2–1.4× the time without jitter on the benchmark frames (README). The
+//! baseline build multiplies and adds separately, so the two builds differ by rounding. Cost
+//! and its breakdown: `crates/bench/benches/separable.rs` and the README.
 //!
 //! Output: per pixel, the diffuse exitance E ∗ R_d (with [`crate::Energy::TotalReflectance`]
 //! kernels); the caller applies its Fresnel / π factors. Background pixels
