@@ -604,10 +604,17 @@ fn separable(c: &mut Criterion) {
     // the minimum is what the code costs and the ratios between minima are stable, where
     // criterion's means carry whatever the neighbours did during each case's turn.
     let rounds = 30;
-    let filter =
-        |f: &Frame, kernel: &SeparableKernel, scratch: &mut Vec<[f32; 3]>, out: &mut [[f32; 3]]| {
-            screen_space::filter_into(&f.input(), kernel, &opts, scratch, out).expect("filter")
-        };
+    let no_jitter = FilterOptions {
+        jitter_radius: 0.0,
+        ..opts
+    };
+    let filter = |f: &Frame,
+                  kernel: &SeparableKernel,
+                  opts: &FilterOptions,
+                  scratch: &mut Vec<[f32; 3]>,
+                  out: &mut [[f32; 3]]| {
+        screen_space::filter_into(&f.input(), kernel, opts, scratch, out).expect("filter")
+    };
     let mut best = [f64::INFINITY; 10];
     let names = [
         "copy",
@@ -621,10 +628,6 @@ fn separable(c: &mut Criterion) {
         "pass, no jitter, 2 threads",
         "6 Gaussians, 2 threads",
     ];
-    let no_jitter = FilterOptions {
-        jitter_radius: 0.0,
-        ..opts
-    };
     for _ in 0..rounds {
         let mut time = |k: usize, run: &mut dyn FnMut()| {
             let t = std::time::Instant::now();
@@ -642,25 +645,22 @@ fn separable(c: &mut Criterion) {
             two.install(|| var.run(&frame, &mut tmp, &mut out))
         });
         time(4, &mut || {
-            one.install(|| filter(&frame, &pre7, &mut scratch, &mut out))
+            one.install(|| filter(&frame, &pre7, &opts, &mut scratch, &mut out))
         });
         time(5, &mut || {
-            two.install(|| filter(&frame, &pre7, &mut scratch, &mut out))
+            two.install(|| filter(&frame, &pre7, &opts, &mut scratch, &mut out))
         });
         time(6, &mut || {
-            one.install(|| filter(&tilted, &pre7, &mut scratch, &mut out))
+            one.install(|| filter(&tilted, &pre7, &opts, &mut scratch, &mut out))
         });
         time(7, &mut || {
-            two.install(|| filter(&tilted, &pre7, &mut scratch, &mut out))
+            two.install(|| filter(&tilted, &pre7, &opts, &mut scratch, &mut out))
         });
         time(8, &mut || {
-            two.install(|| {
-                screen_space::filter_into(&frame.input(), &pre7, &no_jitter, &mut scratch, &mut out)
-                    .expect("filter")
-            })
+            two.install(|| filter(&frame, &pre7, &no_jitter, &mut scratch, &mut out))
         });
         time(9, &mut || {
-            two.install(|| filter(&frame, &gauss6, &mut scratch, &mut out))
+            two.install(|| filter(&frame, &gauss6, &opts, &mut scratch, &mut out))
         });
     }
     eprintln!("fastest of {rounds} interleaved rounds (1080p):");

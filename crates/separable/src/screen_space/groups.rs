@@ -27,7 +27,7 @@
 //! last), within the tolerance stated in [`super`].
 
 use super::pixel::Pass;
-use super::rows::{ChunkTaps, Ctx, RowOut};
+use super::rows::{ChunkTaps, Ctx, RowOut, store};
 use std::arch::x86_64::*;
 
 /// Pixels per group (one 8-lane register per channel triple of floats).
@@ -56,11 +56,11 @@ impl GroupTaps {
             axis: Vec::new(),
             rotated: Vec::new(),
         };
-        for (k, (&o, w)) in t.offset.iter().zip(&t.weight).enumerate() {
-            let w24: [f32; 3 * G] = std::array::from_fn(|i| w[i % 3]);
+        for (k, &o) in t.offset.iter().enumerate() {
+            let w24: [f32; 3 * G] = taps.pattern[k][..3 * G].try_into().expect("24 floats");
             if o == 0.0 {
                 g.centre.push(w24);
-            } else if pass.jitter && o.abs() <= pass.rotate_limit_mm {
+            } else if pass.rotates(o) {
                 g.rotated.push((o, taps.rot_lo[k], taps.rot_d[k]));
             } else {
                 g.axis.push((o, w24));
@@ -147,8 +147,8 @@ pub(super) struct Sources<'a> {
 const GROUPS: usize = super::rows::CHUNK / G;
 
 /// Sums the `n` pixels of row `y` from column `x0` (a chunk that passed the silhouette test)
-/// into `out`: whole groups of 8 here, the
-/// rest (and any group the registers cannot take) pixel by pixel.
+/// into `out`: whole groups of 8 here, the rest (and any group the registers cannot take)
+/// pixel by pixel.
 ///
 /// The taps are the outer loop and the groups the inner one, so that what a tap needs once
 /// per chunk (its integer offset when the chunk's pixels share it, and where its runs start)
@@ -183,9 +183,14 @@ pub(super) fn chunk<const VERTICAL: bool, const JITTER: bool>(
     let mut acc = [[_mm256_setzero_ps(); 3]; GROUPS];
     // Groups that go pixel by pixel (one bit each).
     let mut failed = 0u32;
-    // The horizontal pass reads its padded row, the vertical one the image.
+    // The horizontal pass reads its padded row, the vertical one the image: the first float
+    // of the run at integer offset `k` from the pixels at column `x` (the vertical pass's row
+    // index clamped to the image), or for the horizontal pass the run's first pixel in the
+    // padded row, which may fall outside it.
     let from = if VERTICAL { src } else { srcs.row };
     let last_row = h as i32 - 1;
+    let row_run = |k: i32, x: usize| 3 * ((y as i32 + k).clamp(0, last_row) as usize * w + x);
+    let padded_start = |k: i32, x: usize| srcs.pad as isize + x as isize + k as isize;
 
     for wt in &gt.centre {
         let wv = [load(wt, 0), load(wt, 8), load(wt, 16)];
@@ -227,10 +232,9 @@ pub(super) fn chunk<const VERTICAL: bool, const JITTER: bool>(
         let runs = if c != top {
             None
         } else if VERTICAL {
-            let row = |t: i32| 3 * ((y as i32 + c + t).clamp(0, last_row) as usize * w + x0);
-            Some((row(0), row(1)))
+            Some((row_run(c, x0), row_run(c + 1, x0)))
         } else {
-            let start = srcs.pad as isize + x0 as isize + c as isize;
+            let start = padded_start(c, x0);
             (start >= 0 && start as usize + G * groups < srcs.row.len() / 3)
                 .then(|| (3 * start as usize, 3 * start as usize + 3))
         };
@@ -260,10 +264,9 @@ pub(super) fn chunk<const VERTICAL: bool, const JITTER: bool>(
             }
             let xg = x0 + G * g;
             let r: [usize; 3] = if VERTICAL {
-                let row = |t: i32| 3 * ((y as i32 + lo + t).clamp(0, last_row) as usize * w + xg);
-                [row(0), row(1), row(2)]
+                [row_run(lo, xg), row_run(lo + 1, xg), row_run(lo + 2, xg)]
             } else {
-                let start = srcs.pad as isize + xg as isize + lo as isize;
+                let start = padded_start(lo, xg);
                 if start < 0 || start as usize + G + 2 > srcs.row.len() / 3 {
                     failed |= 1 << g;
                     continue;
@@ -333,11 +336,7 @@ fn pixels<const VERTICAL: bool, const JITTER: bool>(
     out: &mut RowOut,
 ) {
     for x in a..b {
-        let v = pass.pixel::<VERTICAL, JITTER>(x, y);
-        let d = &mut out.row[3 * x..3 * x + 3];
-        for c in 0..3 {
-            d[c] = if out.accumulate { d[c] + v[c] } else { v[c] };
-        }
+        store(out, &pass.pixel::<VERTICAL, JITTER>(x, y), x);
     }
 }
 

@@ -75,6 +75,13 @@ struct Acc {
 }
 
 impl Pass<'_> {
+    /// Whether a tap at `o_mm` is read along the pixel's rotated axis (jitter on, and the
+    /// tap within the rotation radius).
+    #[inline(always)]
+    pub fn rotates(&self, o_mm: f32) -> bool {
+        self.jitter && o_mm.abs() <= self.rotate_limit_mm
+    }
+
     /// Whether texel `j` is dropped (another object, or a depth jump).
     #[inline(always)]
     fn dropped(&self, j: usize, id: u32, d0: f32) -> bool {
@@ -126,7 +133,7 @@ impl Pass<'_> {
         };
         for (&o_mm, wt) in t.offset.iter().zip(&t.weight) {
             let o = o_mm * inv;
-            if self.jitter && o_mm.abs() <= self.rotate_limit_mm {
+            if self.rotates(o_mm) {
                 // Rotated axis: bilinear fetch at p − o·dir.
                 let (sx, sy) = (x as f32 - o * rdx, y as f32 - o * rdy);
                 let ([j00, j01, j10, j11], fx, fy) = bilinear_cell(sx, sy, w, wmax, hmax);
@@ -188,7 +195,7 @@ impl Pass<'_> {
             let v = if o_mm == 0.0 {
                 // The centre tap reads the pixel itself, whatever the rotation.
                 centre
-            } else if JITTER && o_mm.abs() <= self.rotate_limit_mm {
+            } else if JITTER && self.rotates(o_mm) {
                 let (sx, sy) = (x as f32 - o * rdx, y as f32 - o * rdy);
                 let ([j00, j01, j10, j11], fx, fy) = bilinear_cell(sx, sy, w, wmax, hmax);
                 if !(kept(j00) && kept(j01) && kept(j10) && kept(j11)) {

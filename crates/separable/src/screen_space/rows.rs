@@ -282,7 +282,7 @@ impl PixelTable {
 /// A pass's taps laid out for the flat chunk loops.
 pub(super) struct ChunkTaps {
     /// Per tap, its RGB weights repeated over a chunk's floats.
-    pattern: Vec<[f32; FLOATS]>,
+    pub(super) pattern: Vec<[f32; FLOATS]>,
     /// Per tap, the weights of a rotated read's row pair (RGB of the left texel, RGB of the
     /// right one, two unused lanes) at fx = 0, and their change per unit of fx: the weights
     /// are `lo + fx · d` = [(1 − fx)·wt, fx·wt, 0, 0]. Runtime arrays, so the compiler keeps
@@ -301,7 +301,7 @@ impl ChunkTaps {
         let t: &PassTaps = pass.taps;
         let (mut axis_mm, mut rotated_mm) = (0.0f32, 0.0f32);
         for &o in &t.offset {
-            if pass.jitter && o.abs() <= pass.rotate_limit_mm {
+            if pass.rotates(o) {
                 rotated_mm = rotated_mm.max(o.abs());
             } else {
                 axis_mm = axis_mm.max(o.abs());
@@ -350,7 +350,7 @@ pub(super) struct Lanes {
     /// x coordinate.
     px: [f32; CHUNK],
     /// 1 / mm_per_pixel.
-    pub(super) inv: [f32; CHUNK],
+    inv: [f32; CHUNK],
     /// The horizontal pass's source row padded by its edge pixels (AVX2 build).
     padrow: Vec<f32>,
     /// An axis tap's fractional position per pixel, and the same repeated over the channels.
@@ -435,7 +435,7 @@ pub(super) fn row<const VERTICAL: bool, const JITTER: bool>(
         // calling a function compiled with `target_feature(enable = "avx2,fma")`.
         return unsafe { row_avx2::<VERTICAL, JITTER>(pass, ctx, lanes, y, out) };
     }
-    row_any::<VERTICAL, JITTER, Separate>(pass, ctx, lanes, y, out)
+    row_any::<VERTICAL, JITTER, false>(pass, ctx, lanes, y, out)
 }
 
 /// [`row_any`] compiled for AVX2 and FMA: the chunks that pass the test are summed by
@@ -451,57 +451,18 @@ fn row_avx2<const VERTICAL: bool, const JITTER: bool>(
     y: usize,
     out: RowOut,
 ) -> usize {
-    row_any::<VERTICAL, JITTER, Fused>(pass, ctx, lanes, y, out)
+    row_any::<VERTICAL, JITTER, true>(pass, ctx, lanes, y, out)
 }
 
-/// How the chunk loops multiply and add: `a · b + c` fused (one rounding, where the CPU has
-/// FMA) or as two operations (the baseline build, where a fused multiply-add would be a
-/// library call).
-pub(super) trait MulAdd {
-    /// Whether this is the AVX2 + FMA build ([`Fused`], only used by `row_avx2`, after the
-    /// CPU check).
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-    const AVX2: bool;
-    /// a · b + c.
-    fn fma(a: f32, b: f32, c: f32) -> f32;
-    /// ⌊x⌋ for |x| < 2²² (exact either way: one rounding instruction where the build has
-    /// SSE4.1, else [`floor_small`]).
-    fn floor(x: f32) -> f32;
-}
-
-/// [`MulAdd`] as one fused operation ([`f32::mul_add`]).
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-pub(super) struct Fused;
-
-/// [`MulAdd`] as a multiply and an add.
-pub(super) struct Separate;
-
-impl MulAdd for Fused {
-    const AVX2: bool = true;
-    #[inline(always)]
-    fn fma(a: f32, b: f32, c: f32) -> f32 {
-        a.mul_add(b, c)
-    }
-    #[inline(always)]
-    fn floor(x: f32) -> f32 {
-        x.floor()
-    }
-}
-
-impl MulAdd for Separate {
-    const AVX2: bool = false;
-    #[inline(always)]
-    fn fma(a: f32, b: f32, c: f32) -> f32 {
-        a * b + c
-    }
-    #[inline(always)]
-    fn floor(x: f32) -> f32 {
-        floor_small(x)
-    }
+/// `a · b + c` as a multiply and an add (the portable loops' rounding; a fused multiply-add
+/// would be a library call in the baseline build).
+#[inline(always)]
+fn mul_add(a: f32, b: f32, c: f32) -> f32 {
+    a * b + c
 }
 
 #[inline(always)]
-fn row_any<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
+fn row_any<const VERTICAL: bool, const JITTER: bool, const AVX2: bool>(
     pass: &Pass,
     ctx: &Ctx,
     lanes: &mut Lanes,
@@ -509,34 +470,39 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
     mut out: RowOut,
 ) -> usize {
     let w = pass.input.width;
+    // The horizontal pass's padded source row (AVX2 build) and its padding, built for the
+    // row's first chunk that passes the test.
     #[cfg(target_arch = "x86_64")]
     let mut padrow = std::mem::take(&mut lanes.padrow);
     #[cfg(target_arch = "x86_64")]
-    let pad = if A::AVX2 && !VERTICAL {
-        let pad = row_reach(ctx, y);
-        super::groups::pad_row(pass.src.as_flattened(), w, y, pad, &mut padrow);
-        pad
-    } else {
-        0
-    };
+    let mut padding: Option<usize> = None;
     // A chunk of `n` pixels from `x0` through the fast path, if it passes the test.
-    let fast_chunk = |lanes: &mut Lanes, out: &mut RowOut, x0: usize, n: usize| {
+    let mut fast_chunk = |lanes: &mut Lanes, out: &mut RowOut, x0: usize, n: usize| {
         if !eligible::<VERTICAL, JITTER>(pass, ctx, x0, y, n) {
             return false;
         }
         #[cfg(target_arch = "x86_64")]
-        if A::AVX2 {
+        if AVX2 {
+            let pad = if VERTICAL {
+                0
+            } else {
+                *padding.get_or_insert_with(|| {
+                    let pad = row_reach(ctx, y);
+                    super::groups::pad_row(pass.src.as_flattened(), w, y, pad, &mut padrow);
+                    pad
+                })
+            };
             let srcs = super::groups::Sources {
                 src: pass.src.as_flattened(),
                 row: &padrow,
                 pad,
             };
-            // SAFETY: `A::AVX2` is only true for `Fused`, which only `row_avx2` uses, after
-            // checking that the CPU has AVX2 and FMA.
+            // SAFETY: `AVX2` is only true in `row_avx2`, which is only called after checking
+            // that the CPU has AVX2 and FMA.
             unsafe { super::groups::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out) };
             return true;
         }
-        sum_chunk::<VERTICAL, JITTER, A>(pass, ctx, lanes, x0, y, n);
+        sum_chunk::<VERTICAL, JITTER>(pass, ctx, lanes, x0, y, n);
         store(out, &lanes.acc[..3 * n], x0);
         true
     };
@@ -583,7 +549,7 @@ fn row_reach(ctx: &Ctx, y: usize) -> usize {
 
 /// Writes (or adds) the RGB values `v` at pixel `x0` of the output row.
 #[inline(always)]
-fn store(out: &mut RowOut, v: &[f32], x0: usize) {
+pub(super) fn store(out: &mut RowOut, v: &[f32], x0: usize) {
     let dst = &mut out.row[3 * x0..3 * x0 + v.len()];
     if out.accumulate {
         for (d, a) in dst.iter_mut().zip(v) {
@@ -712,7 +678,7 @@ fn eligible<const VERTICAL: bool, const JITTER: bool>(
 /// The taps of a chunk that passed [`eligible`], summed into `lanes.acc` (the portable
 /// form).
 #[inline(always)]
-fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
+fn sum_chunk<const VERTICAL: bool, const JITTER: bool>(
     pass: &Pass,
     ctx: &Ctx,
     lanes: &mut Lanes,
@@ -760,17 +726,17 @@ fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
             // The centre tap reads the pixel itself.
             let s = &src[3 * i0..3 * i0 + m];
             for i in 0..m {
-                lanes.acc[i] = A::fma(pattern[i], s[i], lanes.acc[i]);
+                lanes.acc[i] = mul_add(pattern[i], s[i], lanes.acc[i]);
             }
-        } else if JITTER && o_mm.abs() <= pass.rotate_limit_mm {
+        } else if JITTER && pass.rotates(o_mm) {
             // Rotated tap: a bilinear read at p − o·dir. Positions and cells for all pixels,
             // then per pixel the reads and the blend.
             if inside == ROTATED {
-                rotated_sums::<A>(lanes, taps, src, w, n, inside);
+                rotated_sums(lanes, taps, src, w, n, inside);
                 inside = 0;
             }
             let (wf, hf) = (wmax as f32, hmax as f32);
-            let edge = rotated_cells::<VERTICAL, A>(
+            let edge = rotated_cells::<VERTICAL>(
                 (o_mm, yf, w, wf, hf),
                 &lanes.inv[..n],
                 (&lanes.px[..n], &lanes.rdx[..n], &lanes.rdy[..n]),
@@ -806,10 +772,10 @@ fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
                     let b1 = texel4(src, lanes.j[3][l]);
                     let (fx, fy) = (lanes.rfx[inside][l], lanes.rfy[inside][l]);
                     for c in 0..3 {
-                        let top = A::fma(fx, a1[c] - a0[c], a0[c]);
-                        let bottom = A::fma(fx, b1[c] - b0[c], b0[c]);
+                        let top = mul_add(fx, a1[c] - a0[c], a0[c]);
+                        let bottom = mul_add(fx, b1[c] - b0[c], b0[c]);
                         let a = &mut lanes.acc[3 * l + c];
-                        *a = A::fma(wt[c], A::fma(fy, bottom - top, top), *a);
+                        *a = mul_add(wt[c], mul_add(fy, bottom - top, top), *a);
                     }
                 }
             }
@@ -820,7 +786,7 @@ fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
             for l in 0..n {
                 let o = o_mm * lanes.inv[l];
                 let p = if VERTICAL { yf } else { lanes.px[l] } - o;
-                let p0 = A::floor(p);
+                let p0 = floor_small(p);
                 lanes.frac[l] = p - p0;
                 // The first texel's coordinate minus the pixel's own offset in the chunk (one
                 // value for the whole chunk unless the footprint changes across it), as the
@@ -847,8 +813,8 @@ fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
                 let s0 = &src[3 * first..3 * first + m];
                 let s1 = &src[3 * (first + next)..3 * (first + next) + m];
                 for i in 0..m {
-                    let v = A::fma(frac[i], s1[i] - s0[i], s0[i]);
-                    lanes.acc[i] = A::fma(pattern[i], v, lanes.acc[i]);
+                    let v = mul_add(frac[i], s1[i] - s0[i], s0[i]);
+                    lanes.acc[i] = mul_add(pattern[i], v, lanes.acc[i]);
                 }
             } else if spread == 1 && c0 >= 0 && last <= lim {
                 // Two offsets (the footprint changes across the chunk): three contiguous runs,
@@ -864,8 +830,8 @@ fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
                 for i in 0..m {
                     let up = hi[i] != 0.0;
                     let (a, b) = if up { (s1[i], s2[i]) } else { (s0[i], s1[i]) };
-                    let v = A::fma(frac[i], b - a, a);
-                    lanes.acc[i] = A::fma(pattern[i], v, lanes.acc[i]);
+                    let v = mul_add(frac[i], b - a, a);
+                    lanes.acc[i] = mul_add(pattern[i], v, lanes.acc[i]);
                 }
             } else {
                 for l in 0..n {
@@ -879,15 +845,15 @@ fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
                     };
                     for c in 0..3 {
                         let (s0, s1) = (src[3 * j0 + c], src[3 * j1 + c]);
-                        let v = A::fma(frac[3 * l], s1 - s0, s0);
-                        lanes.acc[3 * l + c] = A::fma(wt[c], v, lanes.acc[3 * l + c]);
+                        let v = mul_add(frac[3 * l], s1 - s0, s0);
+                        lanes.acc[3 * l + c] = mul_add(wt[c], v, lanes.acc[3 * l + c]);
                     }
                 }
             }
         }
     }
     if inside > 0 {
-        rotated_sums::<A>(lanes, taps, src, w, n, inside);
+        rotated_sums(lanes, taps, src, w, n, inside);
     }
 }
 
@@ -898,7 +864,7 @@ fn sum_chunk<const VERTICAL: bool, const JITTER: bool, A: MulAdd>(
 /// are folded and written as 4 floats that overlap the next pixel's (in order, so each keeps
 /// its 3), then added.
 #[inline(always)]
-fn rotated_sums<A: MulAdd>(
+fn rotated_sums(
     lanes: &mut Lanes,
     taps: &ChunkTaps,
     src: &[f32],
@@ -924,9 +890,9 @@ fn rotated_sums<A: MulAdd>(
             let (fx, fy) = (rfx[q][l], rfy[q][l]);
             let k = rtap[q];
             let (wlo, wd) = (&taps.rot_lo[k], &taps.rot_d[k]);
-            let v: [f32; 8] = std::array::from_fn(|i| A::fma(fy, b[i] - a[i], a[i]));
-            let x: [f32; 8] = std::array::from_fn(|i| A::fma(fx, wd[i], wlo[i]));
-            r = std::array::from_fn(|i| A::fma(x[i], v[i], r[i]));
+            let v: [f32; 8] = std::array::from_fn(|i| mul_add(fy, b[i] - a[i], a[i]));
+            let x: [f32; 8] = std::array::from_fn(|i| mul_add(fx, wd[i], wlo[i]));
+            r = std::array::from_fn(|i| mul_add(x[i], v[i], r[i]));
         }
         // (The fourth float, overwritten by the next pixel's, folds the two spare lanes: it
         // keeps all eight lanes live, so the compiler reads them as one vector.)
@@ -944,7 +910,7 @@ fn rotated_sums<A: MulAdd>(
 /// the border (then `rj` is not valid). Separate arguments, so the compiler knows the arrays
 /// do not overlap and vectorises the loop.
 #[inline(always)]
-fn rotated_cells<const VERTICAL: bool, A: MulAdd>(
+fn rotated_cells<const VERTICAL: bool>(
     (o_mm, yf, w, wf, hf): (f32, f32, usize, f32, f32),
     inv: &[f32],
     (px, rdx, rdy): (&[f32], &[f32], &[f32]),
@@ -970,7 +936,7 @@ fn rotated_cells<const VERTICAL: bool, A: MulAdd>(
             px[l] - o * rdx[l]
         };
         let sy = yf - o * rdy[l];
-        let (cx, cy) = (A::floor(sx), A::floor(sy));
+        let (cx, cy) = (floor_small(sx), floor_small(sy));
         rfx[l] = sx - cx;
         rfy[l] = sy - cy;
         edge |= u32::from(cx < 0.0) | u32::from(cx >= wf);
