@@ -464,7 +464,7 @@ fn separable(c: &mut Criterion) {
     let frame = Frame::new(1920, 1080);
     let n = frame.width * frame.height;
     let mut out = vec![[0.0f32; 3]; n];
-    let mut scratch = Vec::new();
+    let mut scratch = screen_space::FilterScratch::default();
     let mut aux = vec![(0.0f32, 0u32, 0.0f32); n];
     let (one, two) = (pool(1), pool(2));
 
@@ -611,7 +611,7 @@ fn separable(c: &mut Criterion) {
     let filter = |f: &Frame,
                   kernel: &SeparableKernel,
                   opts: &FilterOptions,
-                  scratch: &mut Vec<[f32; 3]>,
+                  scratch: &mut screen_space::FilterScratch,
                   out: &mut [[f32; 3]]| {
         screen_space::filter_into(&f.input(), kernel, opts, scratch, out).expect("filter")
     };

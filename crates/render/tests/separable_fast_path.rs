@@ -59,7 +59,7 @@ fn built_in_scenes_filter_alike_on_both_paths() {
                         &input,
                         &kernel,
                         &opts,
-                        &mut Vec::new(),
+                        &mut Default::default(),
                         &mut out,
                         evaluation,
                     )

@@ -102,7 +102,7 @@ pub mod taps;
 pub use error::SeparableError;
 pub use kernel::{Energy, Kernel1d, Profile1d, SeparableKernel, SeparableTerm, Tap};
 pub use kernel2d::{Kernel2d, Kernel2dSpec};
-pub use screen_space::{FilterOptions, NO_OBJECT, ScreenInput};
+pub use screen_space::{FilterOptions, FilterScratch, NO_OBJECT, ScreenInput};
 pub use special::{erf, erfc, gaussian_mass};
 pub use taps::TapPlacement;
 

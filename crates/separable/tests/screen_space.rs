@@ -235,7 +235,7 @@ fn bad_input_is_an_error() {
             &f.input(),
             &kernel,
             &FilterOptions::default(),
-            &mut Vec::new(),
+            &mut Default::default(),
             &mut out
         )
         .is_err()

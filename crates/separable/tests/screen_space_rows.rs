@@ -37,9 +37,15 @@ fn run_with(
     e: Evaluation,
 ) -> (Vec<[f32; 3]>, f64) {
     let mut out = vec![[0.0; 3]; f.width * f.height];
-    let fast =
-        screen_space::filter_into_with(&f.input(), kernel, opts, &mut Vec::new(), &mut out, e)
-            .unwrap();
+    let fast = screen_space::filter_into_with(
+        &f.input(),
+        kernel,
+        opts,
+        &mut Default::default(),
+        &mut out,
+        e,
+    )
+    .unwrap();
     (out, fast)
 }
 
@@ -327,4 +333,67 @@ fn the_chunked_pass_gives_the_same_bits_for_any_thread_count() {
             }
         }
     }
+}
+
+/// A [`screen_space::FilterScratch`] kept across frames gives the bits of a fresh one, frame
+/// after frame, as the size, the seed, the jitter and the content change (its rotation table
+/// is reused only for the same size and seed; its summary buffers are rewritten). Every
+/// frame here differs from the one before in exactly one of those, so a table or a summary
+/// kept when it should not be shows as a mismatch.
+#[test]
+fn a_scratch_kept_across_frames_gives_the_bits_of_a_fresh_one() {
+    let kernel = &kernels()[0].1;
+    let mut moved = hard_frame(203, 71);
+    moved.set_irradiance(|x, y| hash01(x + 7, y));
+    moved.mm_per_pixel.iter_mut().for_each(|m| *m *= 1.5);
+    moved.mask[50 * 203..52 * 203].fill(BACKGROUND);
+    let frames = [
+        hard_frame(203, 71),
+        hard_frame(203, 71),
+        moved,
+        hard_frame(71, 203),
+        hard_frame(203, 71),
+    ];
+    let opts = |seed, jitter_radius| FilterOptions {
+        jitter_radius,
+        seed,
+        ..Default::default()
+    };
+    // (frame, seed, jitter): same twice, new content, new size (same pixel count), back, new
+    // seed, no jitter, jitter again.
+    let sequence = [
+        (0, 5, 0.3),
+        (1, 5, 0.3),
+        (2, 5, 0.3),
+        (3, 5, 0.3),
+        (4, 5, 0.3),
+        (4, 6, 0.3),
+        (4, 6, 0.0),
+        (4, 6, 0.3),
+        (0, 5, 1.0),
+    ];
+    let mut kept = screen_space::FilterScratch::default();
+    for (step, &(i, seed, jitter)) in sequence.iter().enumerate() {
+        let f = &frames[i];
+        let o = opts(seed, jitter);
+        let mut got = vec![[0.0; 3]; f.width * f.height];
+        screen_space::filter_into(&f.input(), kernel, &o, &mut kept, &mut got).unwrap();
+        let fresh = run(f, kernel, &o, Evaluation::Rows);
+        let off = got
+            .iter()
+            .zip(&fresh)
+            .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+            .count();
+        assert_eq!(
+            off, 0,
+            "step {step} (frame {i}, seed {seed}, jitter {jitter})"
+        );
+    }
+    // The steps differ from each other (so each one checks something).
+    let a = run(&frames[4], kernel, &opts(5, 0.3), Evaluation::Rows);
+    let b = run(&frames[4], kernel, &opts(6, 0.3), Evaluation::Rows);
+    let c = run(&frames[2], kernel, &opts(5, 0.3), Evaluation::Rows);
+    let d = run(&frames[0], kernel, &opts(5, 0.3), Evaluation::Rows);
+    assert!(a.iter().zip(&b).filter(|(x, y)| x != y).count() > 1000);
+    assert!(c.iter().zip(&d).filter(|(x, y)| x != y).count() > 1000);
 }

@@ -131,7 +131,7 @@ fn timed_filter(frame: &Frame, kernel: &SeparableKernel, threads: usize) -> Resu
         .map_err(|e| Error(e.to_string()))?;
     let opts = FilterOptions::default();
     let mut out = vec![[0.0f32; 3]; frame.width * frame.height];
-    let mut scratch = Vec::new();
+    let mut scratch = screen_space::FilterScratch::default();
     let input = frame.input();
     let mut best = f64::INFINITY;
     // Best of two runs (the first warms the caches).

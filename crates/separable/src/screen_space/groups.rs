@@ -20,8 +20,9 @@
 //!   and cells of the 8 pixels are computed in registers, then each pixel reads its cell's
 //!   two rows as two 8-float loads (the cell's two texels are six contiguous floats), blends
 //!   them along y, weights them by [(1 − fx)·w, fx·w] and adds them up over the rotated taps;
-//!   the sums are added after the other taps. A tap whose cells reach the image border
-//!   reads each pixel's four texels clamped to the image instead.
+//!   the sums are added after the other taps. A batch of taps with a cell at the image
+//!   border reads each pixel's four texels clamped to the image instead (masked 3-float
+//!   loads, no round trip through memory).
 //!
 //! The rounding differs from the per-pixel form's (fused multiply-adds, rotated taps summed
 //! last), within the tolerance stated in [`super`].
@@ -343,7 +344,7 @@ fn pixels<const VERTICAL: bool, const JITTER: bool>(
 /// The rotated taps of the group at `xg`: each pixel's bilinear reads along its own rotated
 /// axis, summed per pixel (the cell's two rows as 8-float loads: RGB of the left texel, of
 /// the right one, two spare floats; blended along y, weighted by [(1 − fx)·w, fx·w, 0, 0]).
-/// A tap whose cells reach the image border reads each pixel's four clamped texels.
+/// A batch of taps with a cell at the image border reads each pixel's four clamped texels.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 fn rotated<const VERTICAL: bool>(
@@ -410,6 +411,11 @@ struct Geometry {
 }
 
 /// Adds `NQ` rotated taps to each pixel's 8-lane sum in `rsum` (see [`rotated`]).
+///
+/// Each tap's cells and fractions are computed for the 8 pixels in registers and stored
+/// once; the per-pixel loop then reads them back as a scalar index and two broadcast loads
+/// (load-port work, where taking a lane out of a register is a shuffle, and the shuffle
+/// port is the one the rest of the group loop needs).
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
@@ -425,18 +431,14 @@ fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
         _mm256_set1_ps(h as f32 - 2.0),
     );
     let wi = _mm256_set1_epi32(w as i32);
-    let down = 3 * w;
-    let base = src.as_ptr();
-    // Per tap, in registers: each pixel's cell (its first float, for taps inside the image)
-    // and bilinear fractions (lanes are taken out of the registers rather than stored and
-    // read back as scalars: a narrow load of a wide store just written stalls); the cells of
-    // taps that reach past the border (a bit each) as columns and rows.
-    let mut rj = [_mm256_setzero_si256(); NQ];
-    let mut rfx = [_mm256_setzero_ps(); NQ];
-    let mut rfy = [_mm256_setzero_ps(); NQ];
-    let mut rcx = [[0i32; G]; NQ];
-    let mut rcy = [[0i32; G]; NQ];
-    let mut edge = 0u32;
+    // Per tap and pixel: the cell's first float (for cells inside the image) or its column
+    // and row (for a tap whose cells reach past the border), and the bilinear fractions.
+    let mut cell = [[0i32; G]; NQ];
+    let mut col = [[0i32; G]; NQ];
+    let mut row = [[0i32; G]; NQ];
+    let mut fx = [[0f32; G]; NQ];
+    let mut fy = [[0f32; G]; NQ];
+    let mut edge = false;
     for q in 0..NQ {
         let o = _mm256_mul_ps(_mm256_set1_ps(taps[q].0), geo.inv);
         // x − o·c, y − o·s (horizontal); x + o·s, y − o·c (vertical: the axis is (−s, c)),
@@ -453,8 +455,6 @@ fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
             )
         };
         let (cx, cy) = (_mm256_floor_ps(sx), _mm256_floor_ps(sy));
-        rfx[q] = _mm256_sub_ps(sx, cx);
-        rfy[q] = _mm256_sub_ps(sy, cy);
         // Inside: 0 ≤ cx ≤ w − 3 (the 8-float loads read one pixel past the cell) and
         // 0 ≤ cy ≤ h − 2 (positions are finite: inv and the offsets are).
         let outside = _mm256_or_ps(
@@ -467,16 +467,19 @@ fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
                 _mm256_cmp_ps::<_CMP_GT_OQ>(cy, ymax),
             ),
         );
+        edge |= _mm256_movemask_ps(outside) != 0;
         let (cxi, cyi) = (_mm256_cvttps_epi32(cx), _mm256_cvttps_epi32(cy));
         let j = _mm256_add_epi32(cxi, _mm256_mullo_epi32(cyi, wi));
-        rj[q] = _mm256_add_epi32(j, _mm256_add_epi32(j, j));
-        if _mm256_movemask_ps(outside) != 0 {
-            edge |= 1 << q;
-            // SAFETY: each destination holds 8 lanes.
-            unsafe {
-                _mm256_storeu_si256(rcx[q].as_mut_ptr().cast(), cxi);
-                _mm256_storeu_si256(rcy[q].as_mut_ptr().cast(), cyi);
-            }
+        // SAFETY: each destination holds 8 lanes.
+        unsafe {
+            _mm256_storeu_ps(fx[q].as_mut_ptr(), _mm256_sub_ps(sx, cx));
+            _mm256_storeu_ps(fy[q].as_mut_ptr(), _mm256_sub_ps(sy, cy));
+            _mm256_storeu_si256(
+                cell[q].as_mut_ptr().cast(),
+                _mm256_add_epi32(j, _mm256_add_epi32(j, j)),
+            );
+            _mm256_storeu_si256(col[q].as_mut_ptr().cast(), cxi);
+            _mm256_storeu_si256(row[q].as_mut_ptr().cast(), cyi);
         }
     }
     let mut lo = [_mm256_setzero_ps(); NQ];
@@ -485,44 +488,86 @@ fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
         lo[q] = load(&taps[q].1, 0);
         d[q] = load(&taps[q].2, 0);
     }
+    if edge {
+        border_batch(&col, &row, &fx, &fy, &lo, &d, src, (w, h), rsum);
+        return;
+    }
+    let base = src.as_ptr();
+    let down = 3 * w;
     for (l, r) in rsum.iter_mut().enumerate() {
-        let lane = _mm256_set1_epi32(l as i32);
         for q in 0..NQ {
-            let (a, b) = if edge & (1 << q) == 0 {
-                let j = _mm_cvtsi128_si32(_mm256_castsi256_si128(_mm256_permutevar8x32_epi32(
-                    rj[q], lane,
-                ))) as usize;
-                // SAFETY: the cell (cx, cy) was checked inside the image with 0 ≤ cx ≤ w − 3
-                // and 0 ≤ cy ≤ h − 2, so j = 3·(cy·w + cx) and the 8 floats from j + 3w end
-                // at 3·((cy + 1)·w + cx) + 8 ≤ 3·w·h − 1 < src.len().
-                unsafe {
-                    (
-                        _mm256_loadu_ps(base.add(j)),
-                        _mm256_loadu_ps(base.add(j + down)),
-                    )
-                }
-            } else {
-                // Near the border: the four texels clamped to the image, as the per-pixel
-                // form reads them.
-                let (cx, cy) = (rcx[q][l], rcy[q][l]);
-                let col = |c: i32| c.clamp(0, w as i32 - 1) as usize;
-                let row = |c: i32| c.clamp(0, h as i32 - 1) as usize * w;
-                let pick = |r: usize| {
-                    let mut v = [0.0f32; 8];
-                    let (t0, t1) = (3 * (r + col(cx)), 3 * (r + col(cx + 1)));
-                    v[..3].copy_from_slice(&src[t0..t0 + 3]);
-                    v[3..6].copy_from_slice(&src[t1..t1 + 3]);
-                    v
-                };
-                (load(&pick(row(cy)), 0), load(&pick(row(cy + 1)), 0))
+            let j = cell[q][l] as usize;
+            // SAFETY: no cell of the batch reaches the border: each was checked inside the
+            // image with 0 ≤ cx ≤ w − 3 and 0 ≤ cy ≤ h − 2, so j = 3·(cy·w + cx) and the 8
+            // floats from j + 3w end at 3·((cy + 1)·w + cx) + 8 ≤ 3·w·h − 1 < src.len().
+            let (a, b) = unsafe {
+                (
+                    _mm256_loadu_ps(base.add(j)),
+                    _mm256_loadu_ps(base.add(j + down)),
+                )
             };
-            let fy = _mm256_permutevar8x32_ps(rfy[q], lane);
-            let fx = _mm256_permutevar8x32_ps(rfx[q], lane);
-            let v = _mm256_fmadd_ps(fy, _mm256_sub_ps(b, a), a);
-            let x = _mm256_fmadd_ps(fx, d[q], lo[q]);
+            let v = _mm256_fmadd_ps(_mm256_set1_ps(fy[q][l]), _mm256_sub_ps(b, a), a);
+            let x = _mm256_fmadd_ps(_mm256_set1_ps(fx[q][l]), d[q], lo[q]);
             *r = _mm256_fmadd_ps(x, v, *r);
         }
     }
+}
+
+/// [`rotated_batch`] for a batch with a cell at the image border: each pixel's four texels
+/// clamped to the image, as the per-pixel form reads them, for every tap of the batch.
+#[target_feature(enable = "avx2,fma")]
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn border_batch<const NQ: usize>(
+    col: &[[i32; G]; NQ],
+    row: &[[i32; G]; NQ],
+    fx: &[[f32; G]; NQ],
+    fy: &[[f32; G]; NQ],
+    lo: &[__m256; NQ],
+    d: &[__m256; NQ],
+    src: &[f32],
+    (w, h): (usize, usize),
+    rsum: &mut [__m256; G],
+) {
+    let row_of = |c: i32| c.clamp(0, h as i32 - 1) as usize * w;
+    for (l, r) in rsum.iter_mut().enumerate() {
+        for q in 0..NQ {
+            let (cx, cy) = (col[q][l], row[q][l]);
+            let (a, b) = (
+                clamped_pair(src, w, row_of(cy), cx),
+                clamped_pair(src, w, row_of(cy + 1), cx),
+            );
+            let v = _mm256_fmadd_ps(_mm256_set1_ps(fy[q][l]), _mm256_sub_ps(b, a), a);
+            let x = _mm256_fmadd_ps(_mm256_set1_ps(fx[q][l]), d[q], lo[q]);
+            *r = _mm256_fmadd_ps(x, v, *r);
+        }
+    }
+}
+
+/// The texels at columns `cx` and `cx + 1` (clamped to the image) of the row starting at
+/// pixel `r`, as [L.rgb, R.rgb, 0, 0].
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn clamped_pair(src: &[f32], w: usize, r: usize, cx: i32) -> __m256 {
+    let col = |c: i32| 3 * (r + c.clamp(0, w as i32 - 1) as usize);
+    let (a, b) = (
+        &src[col(cx)..col(cx) + 3],
+        &src[col(cx + 1)..col(cx + 1) + 3],
+    );
+    // The first three lanes of a 4-lane load: a texel's RGB, without reading past it.
+    let rgb = _mm_setr_epi32(-1, -1, -1, 0);
+    // SAFETY: `a` and `b` hold three floats each, the masked loads read those only.
+    let (a, b) = unsafe {
+        (
+            _mm_maskload_ps(a.as_ptr(), rgb),
+            _mm_maskload_ps(b.as_ptr(), rgb),
+        )
+    };
+    // [L.rgb, 0, R.rgb, 0] → [L.rgb, R.rgb, 0, 0] (lane 3 is a zero).
+    _mm256_permutevar8x32_ps(
+        _mm256_set_m128(b, a),
+        _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 3, 3),
+    )
 }
 
 /// The 8 pixels' rotated sums as the group's 24 floats of RGB: each pixel's left texel

@@ -64,7 +64,7 @@ use crate::error::{SeparableError, ensure};
 use crate::kernel::SeparableKernel;
 use pixel::{Pass, PassTaps};
 use rayon::prelude::*;
-use rows::{ChunkTaps, Ctx, Lanes, PixelTable, RowOut, Summary};
+use rows::{Cell, ChunkTaps, Ctx, Lanes, PixelTable, RowOut, Summary};
 use sss_util::splitmix64;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -246,6 +246,30 @@ impl Rules {
     }
 }
 
+/// Buffers the filter keeps from one frame to the next ([`filter_into`]): the intermediate
+/// image between the passes, the per-frame silhouette summary, and the per-pixel rotation
+/// table, which depends only on the image size and the seed and so is computed once for a
+/// run of frames that share them. Reusing one across frames saves their allocation (and the
+/// page faults of fresh memory) and the table; a fresh one gives the same output.
+#[derive(Default)]
+pub struct FilterScratch {
+    image: Vec<[f32; 3]>,
+    cells: Vec<Cell>,
+    bands: Vec<Cell>,
+    rotation: Vec<u8>,
+    /// (width, height, seed) of the table in `rotation`, if it holds one.
+    rotation_key: Option<(usize, usize, u64)>,
+}
+
+impl std::fmt::Debug for FilterScratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FilterScratch")
+            .field("pixels", &self.image.len())
+            .field("rotation_key", &self.rotation_key)
+            .finish_non_exhaustive()
+    }
+}
+
 /// Filters `input` with `kernel` into a new image (see the module documentation).
 pub fn filter(
     input: &ScreenInput,
@@ -254,19 +278,17 @@ pub fn filter(
 ) -> Result<Vec<[f32; 3]>, SeparableError> {
     let n = input.width * input.height;
     let mut out = vec![[0.0; 3]; n];
-    let mut scratch = Vec::new();
-    filter_into(input, kernel, opts, &mut scratch, &mut out)?;
+    filter_into(input, kernel, opts, &mut FilterScratch::default(), &mut out)?;
     Ok(out)
 }
 
-/// [`filter`] into caller-provided buffers: `out` must hold width × height pixels;
-/// `scratch` (the intermediate image between the passes) is resized as needed and can be
-/// reused across frames.
+/// [`filter`] into caller-provided buffers: `out` must hold width × height pixels; `scratch`
+/// ([`FilterScratch`]) is resized as needed and is meant to be kept across frames.
 pub fn filter_into(
     input: &ScreenInput,
     kernel: &SeparableKernel,
     opts: &FilterOptions,
-    scratch: &mut Vec<[f32; 3]>,
+    scratch: &mut FilterScratch,
     out: &mut [[f32; 3]],
 ) -> Result<(), SeparableError> {
     run(
@@ -302,7 +324,7 @@ pub fn filter_into_with(
     input: &ScreenInput,
     kernel: &SeparableKernel,
     opts: &FilterOptions,
-    scratch: &mut Vec<[f32; 3]>,
+    scratch: &mut FilterScratch,
     out: &mut [[f32; 3]],
     evaluation: Evaluation,
 ) -> Result<f64, SeparableError> {
@@ -316,7 +338,7 @@ fn run(
     input: &ScreenInput,
     kernel: &SeparableKernel,
     opts: &FilterOptions,
-    scratch: &mut Vec<[f32; 3]>,
+    scratch: &mut FilterScratch,
     out: &mut [[f32; 3]],
     evaluation: Evaluation,
     fast: &AtomicUsize,
@@ -336,7 +358,8 @@ fn run(
     if n == 0 {
         return Ok(());
     }
-    scratch.resize(n, [0.0; 3]);
+    let image = &mut scratch.image;
+    image.resize(n, [0.0; 3]);
     let support = kernel.support_mm.max(kernel.radius_mm());
     let rules = Rules::new(support, opts);
     let jitter = opts.jitter_radius > 0.0;
@@ -352,8 +375,19 @@ fn run(
     let baseline = evaluation == Evaluation::RowsBaseline;
     let tables = chunked.then(|| {
         (
-            Summary::new(input, &rules),
-            PixelTable::new(input, opts.seed, jitter),
+            Summary::new(
+                input,
+                &rules,
+                std::mem::take(&mut scratch.cells),
+                std::mem::take(&mut scratch.bands),
+            ),
+            PixelTable::new(
+                input,
+                opts.seed,
+                jitter,
+                std::mem::take(&mut scratch.rotation),
+                &mut scratch.rotation_key,
+            ),
         )
     });
     for (k, term) in kernel.terms.iter().enumerate() {
@@ -372,14 +406,18 @@ fn run(
             seed: opts.seed,
             rotations: &rotations,
         };
-        run_pass(&horizontal, tables.as_ref(), baseline, scratch, false, fast);
+        run_pass(&horizontal, tables.as_ref(), baseline, image, false, fast);
         let vertical = Pass {
-            src: scratch,
+            src: image,
             taps: &v,
             vertical: true,
             ..horizontal
         };
         run_pass(&vertical, tables.as_ref(), baseline, out, k > 0, fast);
+    }
+    if let Some((summary, table)) = tables {
+        (scratch.cells, scratch.bands) = summary.into_buffers();
+        scratch.rotation = table.rotation;
     }
     Ok(())
 }

@@ -49,7 +49,7 @@ const CELL: usize = 16;
 
 /// One summary cell: a run of up to [`CELL`] pixels of one row.
 #[derive(Clone, Copy, Debug)]
-struct Cell {
+pub(super) struct Cell {
     /// The object id of the cell's first pixel.
     id: u32,
     /// Every pixel has that id (not [`NO_OBJECT`]) and a finite depth.
@@ -159,7 +159,14 @@ fn summary_row(input: &ScreenInput, rules: &Rules, y: usize, row: &mut [Cell]) {
 
 impl Summary {
     /// Scans `input`'s mask, depth and footprint once (`rules`: which pixels are blurred).
-    pub fn new(input: &ScreenInput, rules: &Rules) -> Summary {
+    /// The summary of `input`, in `cells` and `bands` (buffers of an earlier frame, reused:
+    /// every element is written).
+    pub fn new(
+        input: &ScreenInput,
+        rules: &Rules,
+        mut cells: Vec<Cell>,
+        mut bands: Vec<Cell>,
+    ) -> Summary {
         let w = input.width;
         let cols = w.div_ceil(CELL);
         let blank = Cell {
@@ -170,7 +177,7 @@ impl Summary {
             blurred: false,
             inv_max: 0.0,
         };
-        let mut cells = vec![blank; cols * input.height];
+        cells.resize(cols * input.height, blank);
         cells
             .par_chunks_mut(cols.max(1))
             .enumerate()
@@ -184,7 +191,7 @@ impl Summary {
                 summary_row(input, rules, y, row)
             });
         let h = input.height;
-        let mut bands = vec![blank; cols * (h + 1).saturating_sub(BAND)];
+        bands.resize(cols * (h + 1).saturating_sub(BAND), blank);
         bands
             .par_chunks_mut(cols.max(1))
             .enumerate()
@@ -195,6 +202,11 @@ impl Summary {
                 }
             });
         Summary { cols, cells, bands }
+    }
+
+    /// The buffers, for the next frame.
+    pub fn into_buffers(self) -> (Vec<Cell>, Vec<Cell>) {
+        (self.cells, self.bands)
     }
 
     /// The cells holding columns `xs.0..=xs.1` of row `y`.
@@ -254,28 +266,118 @@ impl Summary {
 }
 
 /// The rotation step of every pixel ([`rotation_index`]), shared by every pass and term:
-/// computed once per frame when the filter jitters. (One byte per pixel: a table of its
-/// cosine and sine would save the per-chunk lookup but is 8 times the memory, and a fresh
-/// allocation per frame costs more in page faults than the lookup.)
+/// computed when the filter jitters, and kept in the caller's [`super::FilterScratch`] for
+/// the next frame of the same size and seed. (One byte per pixel: a table of its cosine and
+/// sine would save the per-chunk lookup but is 8 times the memory.)
 pub(super) struct PixelTable {
-    /// Rotation step of each pixel (empty without jitter).
+    /// Rotation step of each pixel (not read without jitter).
     pub(super) rotation: Vec<u8>,
 }
 
 impl PixelTable {
-    /// The table of `input`; rotations only when `jitter`.
-    pub fn new(input: &ScreenInput, seed: u64, jitter: bool) -> PixelTable {
+    /// The table of `input` (rotations only when `jitter`), in `rotation`: the table of an
+    /// earlier frame, kept as it is when that frame had the same size and seed (`key`).
+    pub fn new(
+        input: &ScreenInput,
+        seed: u64,
+        jitter: bool,
+        mut rotation: Vec<u8>,
+        key: &mut Option<(usize, usize, u64)>,
+    ) -> PixelTable {
         let w = input.width;
-        let mut rotation = vec![0u8; if jitter { input.mask.len() } else { 0 }];
+        let now = (w, input.height, seed);
+        if !jitter {
+            return PixelTable { rotation };
+        }
+        if *key == Some(now) && rotation.len() == input.mask.len() {
+            return PixelTable { rotation };
+        }
+        *key = None;
+        rotation.resize(input.mask.len(), 0);
         rotation
             .par_chunks_mut(w.max(1))
             .enumerate()
             .for_each(|(y, row)| {
-                for (x, r) in row.iter_mut().enumerate() {
-                    *r = rotation_index(x, y, seed) as u8;
+                #[cfg(target_arch = "x86_64")]
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: the CPU was just checked to support AVX2, the only requirement
+                    // of calling a function compiled with it.
+                    return unsafe { rotation_row_avx2(y, seed, row) };
                 }
+                rotation_row(y, seed, row)
             });
+        *key = Some(now);
         PixelTable { rotation }
+    }
+}
+
+/// The rotation steps of the pixels of row `y` ([`rotation_index`]).
+fn rotation_row(y: usize, seed: u64, row: &mut [u8]) {
+    for (x, r) in row.iter_mut().enumerate() {
+        *r = rotation_index(x, y, seed) as u8;
+    }
+}
+
+/// [`rotation_row`] four pixels at a time in AVX2's 64-bit lanes: the SplitMix64 finaliser
+/// with each 64-bit product built from three 32-bit ones (AVX2 has no 64-bit multiply), so
+/// every index is the scalar one, bit for bit (integer arithmetic).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn rotation_row_avx2(y: usize, seed: u64, row: &mut [u8]) {
+    use std::arch::x86_64::*;
+    /// a · m (mod 2⁶⁴) per lane, m = (m_hi, m_lo) as 32-bit halves in each lane.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn mul64(a: __m256i, m_lo: __m256i, m_hi: __m256i) -> __m256i {
+        let lo = _mm256_mul_epu32(a, m_lo);
+        let cross = _mm256_add_epi64(
+            _mm256_mul_epu32(_mm256_srli_epi64::<32>(a), m_lo),
+            _mm256_mul_epu32(a, m_hi),
+        );
+        _mm256_add_epi64(lo, _mm256_slli_epi64::<32>(cross))
+    }
+    /// The multipliers of `splitmix64_mix` as (low, high) 32-bit halves in 64-bit lanes.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn halves(m: u64) -> (__m256i, __m256i) {
+        (
+            _mm256_set1_epi64x((m & 0xffff_ffff) as i64),
+            _mm256_set1_epi64x((m >> 32) as i64),
+        )
+    }
+    const _: () = assert!(super::ROTATION_STEPS == 256, "the index is the top byte");
+    let (m1_lo, m1_hi) = halves(0xbf58_476d_1ce4_e5b9);
+    let (m2_lo, m2_hi) = halves(0x94d0_49bb_1331_11eb);
+    // splitmix64(seed + ((y << 32) ^ x)) = mix(seed + (y << 32) + x + γ): x < 2³² (the image
+    // width is at most i32::MAX), so the xor is an add.
+    let start = seed
+        .wrapping_add((y as u64) << 32)
+        .wrapping_add(sss_util::GOLDEN_GAMMA);
+    let mut z0 = _mm256_add_epi64(
+        _mm256_set1_epi64x(start as i64),
+        _mm256_setr_epi64x(0, 1, 2, 3),
+    );
+    let four = _mm256_set1_epi64x(4);
+    let done = row.len() / 4 * 4;
+    let mut quads = row.chunks_exact_mut(4);
+    for q in &mut quads {
+        let mut z = _mm256_xor_si256(z0, _mm256_srli_epi64::<30>(z0));
+        z = mul64(z, m1_lo, m1_hi);
+        z = _mm256_xor_si256(z, _mm256_srli_epi64::<27>(z));
+        z = mul64(z, m2_lo, m2_hi);
+        z = _mm256_xor_si256(z, _mm256_srli_epi64::<31>(z));
+        // The top byte of each lane (`>> 56`; ROTATION_STEPS = 256 makes the `%` a no-op).
+        let top = _mm256_srli_epi64::<56>(z);
+        let mut v = [0u64; 4];
+        // SAFETY: `v` holds four 64-bit lanes.
+        unsafe { _mm256_storeu_si256(v.as_mut_ptr().cast(), top) };
+        for (r, v) in q.iter_mut().zip(v) {
+            *r = v as u8;
+        }
+        z0 = _mm256_add_epi64(z0, four);
+    }
+    for (x, r) in quads.into_remainder().iter_mut().enumerate() {
+        *r = rotation_index(done + x, y, seed) as u8;
     }
 }
 
@@ -948,4 +1050,42 @@ fn rotated_cells<const VERTICAL: bool>(
         rj[l] = bits(cx).wrapping_add(bits(cy).wrapping_mul(w as u32));
     }
     edge != 0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX2 rotation table is the scalar hash, pixel for pixel: row lengths around the
+    /// 4-pixel step, rows far down (y enters the hash's high half), seeds that wrap.
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn avx2_rotation_rows_match_the_scalar_hash() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("skipped: this CPU has no AVX2");
+            return;
+        }
+        let mut checked = 0;
+        for seed in [0, 1, 0x9e37_79b9_7f4a_7c15, u64::MAX - 2] {
+            for y in [0, 1, 7, 1079, 65_537, (1 << 31) - 1] {
+                for w in [0, 1, 3, 4, 5, 8, 13, 1921] {
+                    let (mut a, mut b) = (vec![0u8; w], vec![0u8; w]);
+                    rotation_row(y, seed, &mut a);
+                    // SAFETY: the CPU was checked to support AVX2.
+                    unsafe { rotation_row_avx2(y, seed, &mut b) };
+                    assert_eq!(a, b, "seed {seed}, row {y}, width {w}");
+                    checked += w;
+                }
+            }
+        }
+        // The table is not constant (a broken hash could still agree with itself).
+        let mut row = vec![0u8; 1024];
+        rotation_row(5, 0, &mut row);
+        let distinct = (0..256).filter(|v| row.contains(&(*v as u8))).count();
+        assert!(
+            distinct > 200,
+            "{distinct} distinct rotations in 1024 pixels"
+        );
+        assert_eq!(checked, 24 * 1955);
+    }
 }
