@@ -254,8 +254,8 @@ impl Rules {
 #[derive(Default)]
 pub struct FilterScratch {
     image: Vec<[f32; 3]>,
-    cells: Vec<Cell>,
-    bands: Vec<Cell>,
+    /// The silhouette summary's cells, bands and the bands' working rows.
+    summary: [Vec<Cell>; 3],
     rotation: Vec<u8>,
     /// (width, height, seed) of the table in `rotation`, if it holds one.
     rotation_key: Option<(usize, usize, u64)>,
@@ -375,12 +375,7 @@ fn run(
     let baseline = evaluation == Evaluation::RowsBaseline;
     let tables = chunked.then(|| {
         (
-            Summary::new(
-                input,
-                &rules,
-                std::mem::take(&mut scratch.cells),
-                std::mem::take(&mut scratch.bands),
-            ),
+            Summary::new(input, &rules, std::mem::take(&mut scratch.summary)),
             PixelTable::new(
                 input,
                 opts.seed,
@@ -416,7 +411,7 @@ fn run(
         run_pass(&vertical, tables.as_ref(), baseline, out, k > 0, fast);
     }
     if let Some((summary, table)) = tables {
-        (scratch.cells, scratch.bands) = summary.into_buffers();
+        scratch.summary = summary.into_buffers();
         scratch.rotation = table.rotation;
     }
     Ok(())

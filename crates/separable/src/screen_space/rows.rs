@@ -71,22 +71,58 @@ pub(super) struct Summary {
     cells: Vec<Cell>,
     /// `bands[y * cols + c]` combines cells (y..y + BAND, c), for y + BAND ≤ height.
     bands: Vec<Cell>,
+    /// Working rows of the bands (combinations of 4 rows), kept for the next frame.
+    quads: Vec<Cell>,
+}
+
+/// `dst` row y = `src` rows y and y + `step` joined, for `rows` rows of `cols` cells.
+fn join_rows(
+    src: &[Cell],
+    dst: &mut Vec<Cell>,
+    cols: usize,
+    rows: usize,
+    step: usize,
+    blank: Cell,
+) {
+    dst.resize(cols * rows, blank);
+    dst.par_chunks_mut(cols.max(1))
+        .enumerate()
+        .for_each(|(y, row)| {
+            let (a, b) = (&src[y * cols..], &src[(y + step) * cols..]);
+            for ((d, a), b) in row.iter_mut().zip(a).zip(b) {
+                *d = a.join(*b);
+            }
+        });
 }
 
 /// Rows per band of the summary (so a vertical pass checks a few bands, not every row).
 const BAND: usize = 8;
 
 impl Cell {
-    /// The cell covering both.
+    /// The cell covering both. (Plain comparisons, not `f32::min`: a NaN depth bound only
+    /// occurs in a cell with no finite depth, which is not uniform, and neither is any join
+    /// of it, so its bounds are never read.)
     #[inline]
     fn join(self, o: Cell) -> Cell {
         Cell {
             id: self.id,
-            uniform: self.uniform && o.uniform && self.id == o.id,
-            dmin: self.dmin.min(o.dmin),
-            dmax: self.dmax.max(o.dmax),
-            blurred: self.blurred && o.blurred,
-            inv_max: self.inv_max.max(o.inv_max),
+            uniform: self.uniform & o.uniform & (self.id == o.id),
+            dmin: if o.dmin < self.dmin {
+                o.dmin
+            } else {
+                self.dmin
+            },
+            dmax: if o.dmax > self.dmax {
+                o.dmax
+            } else {
+                self.dmax
+            },
+            blurred: self.blurred & o.blurred,
+            inv_max: if o.inv_max > self.inv_max {
+                o.inv_max
+            } else {
+                self.inv_max
+            },
         }
     }
 
@@ -159,14 +195,10 @@ fn summary_row(input: &ScreenInput, rules: &Rules, y: usize, row: &mut [Cell]) {
 
 impl Summary {
     /// Scans `input`'s mask, depth and footprint once (`rules`: which pixels are blurred).
-    /// The summary of `input`, in `cells` and `bands` (buffers of an earlier frame, reused:
-    /// every element is written).
-    pub fn new(
-        input: &ScreenInput,
-        rules: &Rules,
-        mut cells: Vec<Cell>,
-        mut bands: Vec<Cell>,
-    ) -> Summary {
+    /// The summary of `input`, in `buffers` (cells, bands and the bands' working rows, from
+    /// an earlier frame: every element used is written).
+    pub fn new(input: &ScreenInput, rules: &Rules, buffers: [Vec<Cell>; 3]) -> Summary {
+        let [mut cells, mut bands, mut quads] = buffers;
         let w = input.width;
         let cols = w.div_ceil(CELL);
         let blank = Cell {
@@ -190,23 +222,31 @@ impl Summary {
                 }
                 summary_row(input, rules, y, row)
             });
+        // Bands of 8 rows by doubling: pairs of rows, then pairs of pairs, then of quads
+        // (3 joins per cell instead of 7).
+        const _: () = assert!(BAND == 8, "three doublings");
         let h = input.height;
-        bands.resize(cols * (h + 1).saturating_sub(BAND), blank);
-        bands
-            .par_chunks_mut(cols.max(1))
-            .enumerate()
-            .for_each(|(y, row)| {
-                for (c, band) in row.iter_mut().enumerate() {
-                    *band = (y + 1..y + BAND)
-                        .fold(cells[y * cols + c], |b, r| b.join(cells[r * cols + c]));
-                }
-            });
-        Summary { cols, cells, bands }
+        join_rows(&cells, &mut bands, cols, h.saturating_sub(1), 1, blank);
+        join_rows(&bands, &mut quads, cols, h.saturating_sub(3), 2, blank);
+        join_rows(
+            &quads,
+            &mut bands,
+            cols,
+            (h + 1).saturating_sub(BAND),
+            4,
+            blank,
+        );
+        Summary {
+            cols,
+            cells,
+            bands,
+            quads,
+        }
     }
 
     /// The buffers, for the next frame.
-    pub fn into_buffers(self) -> (Vec<Cell>, Vec<Cell>) {
-        (self.cells, self.bands)
+    pub fn into_buffers(self) -> [Vec<Cell>; 3] {
+        [self.cells, self.bands, self.quads]
     }
 
     /// The cells holding columns `xs.0..=xs.1` of row `y`.
