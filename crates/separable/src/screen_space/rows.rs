@@ -148,11 +148,125 @@ fn order_bits(key: u32) -> u32 {
     key ^ (!pos | 0x8000_0000)
 }
 
-/// [`summary_row`] compiled for AVX2 (the integer folds run 8 lanes wide).
+/// [`summary_row`] in AVX2: each whole cell of [`CELL`] pixels as two 8-lane halves
+/// ([`summary_cell_avx2`]), a partial last cell as the scalar form.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn summary_row_avx2(input: &ScreenInput, rules: &Rules, y: usize, row: &mut [Cell]) {
-    summary_row(input, rules, y, row)
+    let w = input.width;
+    for (c, cell) in row.iter_mut().enumerate() {
+        let a = y * w + c * CELL;
+        let b = (a + CELL).min(y * w + w);
+        let (mask, depth, mm) = (
+            &input.mask[a..b],
+            &input.depth[a..b],
+            &input.mm_per_pixel[a..b],
+        );
+        *cell = match (mask.try_into(), depth.try_into(), mm.try_into()) {
+            (Ok(mask), Ok(depth), Ok(mm)) => summary_cell_avx2(mask, depth, mm, rules),
+            _ => summary_cell(mask, depth, mm, rules),
+        };
+    }
+}
+
+/// [`summary_cell`] of a whole cell in AVX2, the same bits: the folds are integer
+/// (order-preserving keys of the depths, bits of the positive inverse footprints) and the
+/// footprint rule is [`Rules::inverse_scale_lane`]'s f32 operations, lane by lane.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn summary_cell_avx2(
+    mask: &[u32; CELL],
+    depth: &[f32; CELL],
+    mm: &[f32; CELL],
+    rules: &Rules,
+) -> Cell {
+    use std::arch::x86_64::*;
+    const _: () = assert!(CELL == 16, "two 8-lane halves");
+    let id = mask[0];
+    let idv = _mm256_set1_epi32(id as i32);
+    let exp = _mm256_set1_epi32(0x7F80_0000);
+    let sign = _mm256_set1_epi32(i32::MIN);
+    let (one, zero) = (_mm256_set1_ps(1.0), _mm256_setzero_ps());
+    let (twice_support, min_fp) = (
+        _mm256_set1_ps(2.0 * rules.support_mm),
+        _mm256_set1_ps(rules.min_footprint_px),
+    );
+    let (mut odd, mut inv_bits) = (_mm256_setzero_si256(), _mm256_setzero_si256());
+    let (mut lo, mut hi) = (_mm256_set1_epi32(-1), _mm256_setzero_si256());
+    let mut ok_all = -1i32;
+    for half in 0..2 {
+        // SAFETY: each array holds 16 values; the loads read 8 from 0 or 8.
+        let (m, bits, f) = unsafe {
+            (
+                _mm256_loadu_si256(mask.as_ptr().add(8 * half).cast()),
+                _mm256_loadu_si256(depth.as_ptr().add(8 * half).cast()),
+                _mm256_loadu_ps(mm.as_ptr().add(8 * half)),
+            )
+        };
+        // `odd`: another id, or a non-finite depth.
+        let non_finite = _mm256_cmpeq_epi32(_mm256_and_si256(bits, exp), exp);
+        odd = _mm256_or_si256(odd, _mm256_or_si256(_mm256_xor_si256(m, idv), non_finite));
+        // order_key: bits ^ (neg | 0x8000_0000), neg = all ones for a set sign bit.
+        let key = _mm256_xor_si256(bits, _mm256_or_si256(_mm256_srai_epi32::<31>(bits), sign));
+        lo = _mm256_min_epu32(lo, key);
+        hi = _mm256_max_epu32(hi, key);
+        // inverse_scale_lane: (mm > 0) & mm finite & 2·support·inv ≥ min & inv finite.
+        let inv = _mm256_div_ps(one, f);
+        let ok = _mm256_and_ps(
+            _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(f, zero), finite_lanes(f)),
+            _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_GE_OQ>(_mm256_mul_ps(twice_support, inv), min_fp),
+                finite_lanes(inv),
+            ),
+        );
+        ok_all &= _mm256_movemask_ps(ok);
+        inv_bits = _mm256_max_epu32(inv_bits, _mm256_castps_si256(_mm256_and_ps(ok, inv)));
+    }
+    let odd = _mm256_testz_si256(odd, odd) == 0;
+    Cell {
+        id,
+        uniform: id != NO_OBJECT && !odd,
+        dmin: f32::from_bits(order_bits(fold_u32::<false>(lo))),
+        dmax: f32::from_bits(order_bits(fold_u32::<true>(hi))),
+        blurred: ok_all & 0xFF == 0xFF,
+        inv_max: f32::from_bits(fold_u32::<true>(inv_bits)),
+    }
+}
+
+/// The largest (`MAX`) or smallest of the 8 unsigned lanes of `v`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn fold_u32<const MAX: bool>(v: std::arch::x86_64::__m256i) -> u32 {
+    use std::arch::x86_64::*;
+    let mut v = v;
+    for step in 0..3 {
+        let other = match step {
+            0 => _mm256_permute2x128_si256::<1>(v, v),
+            1 => _mm256_shuffle_epi32::<0b01_00_11_10>(v),
+            _ => _mm256_shuffle_epi32::<0b10_11_00_01>(v),
+        };
+        v = if MAX {
+            _mm256_max_epu32(v, other)
+        } else {
+            _mm256_min_epu32(v, other)
+        };
+    }
+    _mm256_cvtsi256_si32(v) as u32
+}
+
+/// All ones in the lanes of `v` that are finite, zeros elsewhere.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn finite_lanes(v: std::arch::x86_64::__m256) -> std::arch::x86_64::__m256 {
+    use std::arch::x86_64::*;
+    let exp = _mm256_set1_epi32(0x7F80_0000);
+    let e = _mm256_and_si256(_mm256_castps_si256(v), exp);
+    _mm256_castsi256_ps(_mm256_xor_si256(
+        _mm256_cmpeq_epi32(e, exp),
+        _mm256_set1_epi32(-1),
+    ))
 }
 
 /// The cells of row `y`.
@@ -162,34 +276,45 @@ fn summary_row(input: &ScreenInput, rules: &Rules, y: usize, row: &mut [Cell]) {
     for (c, cell) in row.iter_mut().enumerate() {
         let a = y * w + c * CELL;
         let b = (a + CELL).min(y * w + w);
-        let id = input.mask[a];
-        // Integer folds (they vectorise; float min/max folds do not): a non-finite depth sets
-        // `odd`, and the depth range is the range of order-preserving keys of the finite
-        // depths; the largest inverse footprint is the largest of their bits (positive
-        // floats order as their bits).
-        let mut odd = 0u32;
-        let (mut lo, mut hi) = (u32::MAX, 0u32);
-        for (&m, &d) in input.mask[a..b].iter().zip(&input.depth[a..b]) {
-            let bits = d.to_bits();
-            odd |= (m ^ id) | u32::from(bits & 0x7F80_0000 == 0x7F80_0000);
-            let key = order_key(bits);
-            lo = lo.min(key);
-            hi = hi.max(key);
-        }
-        let (mut skipped, mut inv_bits) = (0u32, 0u32);
-        for &mm in &input.mm_per_pixel[a..b] {
-            let (inv, ok) = rules.inverse_scale_lane(mm);
-            skipped |= u32::from(!ok);
-            inv_bits = inv_bits.max(if ok { inv.to_bits() } else { 0 });
-        }
-        *cell = Cell {
-            id,
-            uniform: id != NO_OBJECT && odd == 0,
-            dmin: f32::from_bits(order_bits(lo)),
-            dmax: f32::from_bits(order_bits(hi)),
-            blurred: skipped == 0,
-            inv_max: f32::from_bits(inv_bits),
-        };
+        *cell = summary_cell(
+            &input.mask[a..b],
+            &input.depth[a..b],
+            &input.mm_per_pixel[a..b],
+            rules,
+        );
+    }
+}
+
+/// The cell of one run of pixels (their masks, depths and footprints).
+#[inline(always)]
+fn summary_cell(mask: &[u32], depth: &[f32], mm: &[f32], rules: &Rules) -> Cell {
+    let id = mask[0];
+    // Integer folds (they vectorise; float min/max folds do not): a non-finite depth sets
+    // `odd`, and the depth range is the range of order-preserving keys of the depths (of
+    // use only when all are finite); the largest inverse footprint is the largest of their
+    // bits (positive floats order as their bits).
+    let mut odd = 0u32;
+    let (mut lo, mut hi) = (u32::MAX, 0u32);
+    for (&m, &d) in mask.iter().zip(depth) {
+        let bits = d.to_bits();
+        odd |= (m ^ id) | u32::from(bits & 0x7F80_0000 == 0x7F80_0000);
+        let key = order_key(bits);
+        lo = lo.min(key);
+        hi = hi.max(key);
+    }
+    let (mut skipped, mut inv_bits) = (0u32, 0u32);
+    for &mm in mm {
+        let (inv, ok) = rules.inverse_scale_lane(mm);
+        skipped |= u32::from(!ok);
+        inv_bits = inv_bits.max(if ok { inv.to_bits() } else { 0 });
+    }
+    Cell {
+        id,
+        uniform: id != NO_OBJECT && odd == 0,
+        dmin: f32::from_bits(order_bits(lo)),
+        dmax: f32::from_bits(order_bits(hi)),
+        blurred: skipped == 0,
+        inv_max: f32::from_bits(inv_bits),
     }
 }
 
@@ -1095,6 +1220,101 @@ fn rotated_cells<const VERTICAL: bool>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The AVX2 summary cell is the scalar one, bit for bit, on cells that mix every kind of
+    /// value the rules treat apart: other ids, background, non-finite and negative depths,
+    /// −0, zero, negative, non-finite, subnormal and sub-pixel footprints.
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn avx2_summary_cells_match_the_scalar_ones() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("skipped: this CPU has no AVX2");
+            return;
+        }
+        let rules = Rules {
+            support_mm: 14.0,
+            depth_mm: 14.0,
+            min_footprint_px: 1.0,
+        };
+        let depths = [
+            600.0,
+            601.5,
+            -3.0,
+            -0.0,
+            0.0,
+            1e30,
+            f32::NAN,
+            f32::INFINITY,
+            -f32::INFINITY,
+        ];
+        let footprints = [
+            0.5,
+            0.3,
+            27.9,
+            28.1,
+            0.0,
+            -0.5,
+            f32::NAN,
+            f32::INFINITY,
+            1e-40,
+            1e-30,
+        ];
+        let key = |c: &Cell| {
+            (
+                c.id,
+                c.uniform,
+                c.dmin.to_bits(),
+                c.dmax.to_bits(),
+                c.blurred,
+                c.inv_max.to_bits(),
+            )
+        };
+        let (mut uniform, mut blurred) = (0, 0);
+        for t in 0..4000u64 {
+            let r = |k: u64, n: usize| (sss_util::splitmix64(t * 64 + k) % n as u64) as usize;
+            // Most cells clean (one id, finite depths, valid footprints), with a few odd
+            // pixels sprinkled in, so both outcomes of every test are reached.
+            let odd = r(99, 4);
+            let mask: [u32; CELL] = std::array::from_fn(|i| match (odd, r(i as u64, 16)) {
+                (0, 0) => 7,
+                (0, 1) => NO_OBJECT,
+                _ => {
+                    if t % 50 == 0 {
+                        NO_OBJECT
+                    } else {
+                        3
+                    }
+                }
+            });
+            let depth: [f32; CELL] = std::array::from_fn(|i| {
+                if odd == 1 {
+                    depths[r(20 + i as u64, depths.len())]
+                } else {
+                    600.0 + r(20 + i as u64, 1000) as f32 * 0.01
+                }
+            });
+            let mm: [f32; CELL] = std::array::from_fn(|i| {
+                if odd == 2 {
+                    footprints[r(40 + i as u64, footprints.len())]
+                } else {
+                    footprints[r(40 + i as u64, 3)]
+                }
+            });
+            let scalar = summary_cell(&mask, &depth, &mm, &rules);
+            // SAFETY: the CPU was checked to support AVX2.
+            let vector = unsafe { summary_cell_avx2(&mask, &depth, &mm, &rules) };
+            assert_eq!(
+                key(&vector),
+                key(&scalar),
+                "cell {t}: {mask:?} {depth:?} {mm:?}"
+            );
+            uniform += usize::from(scalar.uniform);
+            blurred += usize::from(scalar.blurred);
+        }
+        // Both outcomes of each test were compared.
+        assert!((500..3500).contains(&uniform), "{uniform} uniform cells");
+        assert!((500..3500).contains(&blurred), "{blurred} blurred cells");
+    }
 
     /// The AVX2 rotation table is the scalar hash, pixel for pixel: row lengths around the
     /// 4-pixel step, rows far down (y enters the hash's high half), seeds that wrap.
