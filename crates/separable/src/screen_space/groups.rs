@@ -32,20 +32,21 @@ use super::rows::{ChunkTaps, Ctx, RowOut, store};
 use std::arch::x86_64::*;
 
 /// Pixels per group (one 8-lane register per channel triple of floats).
-const G: usize = 8;
+pub(super) const G: usize = 8;
 /// Rotated taps whose positions a group holds at once (more are summed in batches).
 const HELD: usize = 4;
 
 /// The pass's taps as the group loop uses them, by kind (the centre tap, the axis-aligned
 /// ones, the rotated ones), each with its weights laid out for the group's registers.
 pub(super) struct GroupTaps {
-    /// Offset-0 taps: their weights over a group's 24 floats (RGB repeated).
-    centre: Vec<[f32; 3 * G]>,
-    /// Axis-aligned taps: offset (mm) and weights over the 24 floats.
-    axis: Vec<(f32, [f32; 3 * G])>,
+    /// Offset-0 taps: their weights over 48 floats (RGB repeated: an 8-pixel group reads
+    /// the first 24, a 16-pixel one of [`super::groups16`] all).
+    pub(super) centre: Vec<[f32; 6 * G]>,
+    /// Axis-aligned taps: offset (mm) and weights over the 48 floats.
+    pub(super) axis: Vec<(f32, [f32; 6 * G])>,
     /// Rotated taps: offset (mm) and their row-pair weights at fx = 0 and their change per
     /// unit of fx (see [`ChunkTaps`]).
-    rotated: Vec<(f32, [f32; 8], [f32; 8])>,
+    pub(super) rotated: Vec<(f32, [f32; 8], [f32; 8])>,
 }
 
 impl GroupTaps {
@@ -58,7 +59,7 @@ impl GroupTaps {
             rotated: Vec::new(),
         };
         for (k, &o) in t.offset.iter().enumerate() {
-            let w24: [f32; 3 * G] = taps.pattern[k][..3 * G].try_into().expect("24 floats");
+            let w24: [f32; 6 * G] = taps.pattern[k][..6 * G].try_into().expect("48 floats");
             if o == 0.0 {
                 g.centre.push(w24);
             } else if pass.rotates(o) {
@@ -145,7 +146,7 @@ pub(super) struct Sources<'a> {
 }
 
 /// Groups in a chunk, at most.
-const GROUPS: usize = super::rows::CHUNK / G;
+pub(super) const GROUPS: usize = super::rows::CHUNK / G;
 
 /// Sums the `n` pixels of row `y` from column `x0` (a chunk that passed the silhouette test)
 /// into `out`: whole groups of 8 here, the rest (and any group the registers cannot take)
@@ -329,7 +330,7 @@ pub(super) fn chunk<const VERTICAL: bool, const JITTER: bool>(
 
 /// Pixels `a..b` of row `y` through the per-pixel form.
 #[inline(never)]
-fn pixels<const VERTICAL: bool, const JITTER: bool>(
+pub(super) fn pixels<const VERTICAL: bool, const JITTER: bool>(
     pass: &Pass,
     a: usize,
     b: usize,
@@ -347,7 +348,7 @@ fn pixels<const VERTICAL: bool, const JITTER: bool>(
 /// A batch of taps with a cell at the image border reads each pixel's four clamped texels.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
-fn rotated<const VERTICAL: bool>(
+pub(super) fn rotated<const VERTICAL: bool>(
     pass: &Pass,
     ctx: &Ctx,
     inv: __m256,
@@ -548,7 +549,7 @@ fn border_batch<const NQ: usize>(
 /// pixel `r`, as [L.rgb, R.rgb, 0, 0].
 #[target_feature(enable = "avx2,fma")]
 #[inline]
-fn clamped_pair(src: &[f32], w: usize, r: usize, cx: i32) -> __m256 {
+pub(super) fn clamped_pair(src: &[f32], w: usize, r: usize, cx: i32) -> __m256 {
     let col = |c: i32| 3 * (r + c.clamp(0, w as i32 - 1) as usize);
     let (a, b) = (
         &src[col(cx)..col(cx) + 3],

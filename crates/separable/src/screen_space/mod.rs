@@ -57,6 +57,8 @@
 
 #[cfg(target_arch = "x86_64")]
 mod groups;
+#[cfg(target_arch = "x86_64")]
+mod groups16;
 mod pixel;
 mod rows;
 
@@ -311,6 +313,9 @@ pub enum Evaluation {
     /// [`Evaluation::Rows`] in the x86-64 baseline instruction set even where AVX2 and FMA
     /// are available (multiplies and adds not fused: the two agree within rounding).
     RowsBaseline,
+    /// [`Evaluation::Rows`] with the 8-pixel AVX2 groups even where AVX-512 is available
+    /// (the same sums: the 16-pixel groups do the same operations).
+    RowsAvx2,
     /// Every tap of every pixel fetched and tested on its own: the plain form the chunked one
     /// is tested against (and measured against in `crates/bench/benches/separable.rs`).
     PerPixel,
@@ -372,7 +377,11 @@ fn run(
         .collect();
     // The chunked form indexes texels in i32 / u32 lanes.
     let chunked = evaluation != Evaluation::PerPixel && n <= i32::MAX as usize;
-    let baseline = evaluation == Evaluation::RowsBaseline;
+    let isa = match evaluation {
+        Evaluation::RowsBaseline => Isa::Baseline,
+        Evaluation::RowsAvx2 => Isa::Avx2,
+        _ => Isa::Best,
+    };
     let tables = chunked.then(|| {
         (
             Summary::new(input, &rules, std::mem::take(&mut scratch.summary)),
@@ -401,14 +410,14 @@ fn run(
             seed: opts.seed,
             rotations: &rotations,
         };
-        run_pass(&horizontal, tables.as_ref(), baseline, image, false, fast);
+        run_pass(&horizontal, tables.as_ref(), isa, image, false, fast);
         let vertical = Pass {
             src: image,
             taps: &v,
             vertical: true,
             ..horizontal
         };
-        run_pass(&vertical, tables.as_ref(), baseline, out, k > 0, fast);
+        run_pass(&vertical, tables.as_ref(), isa, out, k > 0, fast);
     }
     if let Some((summary, table)) = tables {
         scratch.summary = summary.into_buffers();
@@ -417,27 +426,39 @@ fn run(
     Ok(())
 }
 
+/// Which instruction set the row-chunked form may use (the widest the CPU has, unless a
+/// test asks for a narrower one).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Isa {
+    /// The x86-64 baseline ([`Evaluation::RowsBaseline`]).
+    Baseline,
+    /// AVX2 and FMA at most ([`Evaluation::RowsAvx2`]).
+    Avx2,
+    /// AVX-512 where the CPU has it.
+    Best,
+}
+
 /// One pass over every row: `pass.src` into `dst`, added to it when `accumulate`.
 fn run_pass(
     pass: &Pass,
     tables: Option<&(Summary, PixelTable)>,
-    baseline: bool,
+    isa: Isa,
     dst: &mut [[f32; 3]],
     accumulate: bool,
     fast: &AtomicUsize,
 ) {
     match (pass.vertical, pass.jitter) {
-        (false, false) => rows_of::<false, false>(pass, tables, baseline, dst, accumulate, fast),
-        (false, true) => rows_of::<false, true>(pass, tables, baseline, dst, accumulate, fast),
-        (true, false) => rows_of::<true, false>(pass, tables, baseline, dst, accumulate, fast),
-        (true, true) => rows_of::<true, true>(pass, tables, baseline, dst, accumulate, fast),
+        (false, false) => rows_of::<false, false>(pass, tables, isa, dst, accumulate, fast),
+        (false, true) => rows_of::<false, true>(pass, tables, isa, dst, accumulate, fast),
+        (true, false) => rows_of::<true, false>(pass, tables, isa, dst, accumulate, fast),
+        (true, true) => rows_of::<true, true>(pass, tables, isa, dst, accumulate, fast),
     }
 }
 
 fn rows_of<const VERTICAL: bool, const JITTER: bool>(
     pass: &Pass,
     tables: Option<&(Summary, PixelTable)>,
-    baseline: bool,
+    isa: Isa,
     dst: &mut [[f32; 3]],
     accumulate: bool,
     fast: &AtomicUsize,
@@ -455,7 +476,9 @@ fn rows_of<const VERTICAL: bool, const JITTER: bool>(
                 taps: &taps,
                 #[cfg(target_arch = "x86_64")]
                 groups: &groups,
-                baseline,
+                baseline: isa == Isa::Baseline,
+                #[cfg(target_arch = "x86_64")]
+                avx512: isa == Isa::Best && std::arch::is_x86_feature_detected!("avx512f"),
             };
             rows.for_each_init(Lanes::new, |lanes, (y, row)| {
                 let out = RowOut {

@@ -607,6 +607,10 @@ pub(super) struct Ctx<'a> {
     pub groups: &'a super::groups::GroupTaps,
     /// Use the x86-64 baseline code even where AVX2 is available (to test it).
     pub baseline: bool,
+    /// Sum the chunks in 16-pixel AVX-512 groups (the CPU has AVX-512F and the caller did
+    /// not ask for AVX2).
+    #[cfg(target_arch = "x86_64")]
+    pub avx512: bool,
 }
 
 /// Per-thread scratch of the chunked pass (structure of arrays over a chunk's pixels, and
@@ -766,7 +770,14 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, const AVX2: bool>(
             };
             // SAFETY: `AVX2` is only true in `row_avx2`, which is only called after checking
             // that the CPU has AVX2 and FMA.
-            unsafe { super::groups::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out) };
+            unsafe {
+                if ctx.avx512 {
+                    // (And `avx512` is only set where the CPU has AVX-512F.)
+                    super::groups16::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out)
+                } else {
+                    super::groups::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out)
+                }
+            };
             return true;
         }
         sum_chunk::<VERTICAL, JITTER>(pass, ctx, lanes, x0, y, n);
