@@ -623,6 +623,7 @@ pub(super) struct Lanes {
     /// 1 / mm_per_pixel.
     inv: [f32; CHUNK],
     /// The horizontal pass's source row padded by its edge pixels (AVX2 build).
+    #[cfg(target_arch = "x86_64")]
     padrow: Vec<f32>,
     /// An axis tap's fractional position per pixel, and the same repeated over the channels.
     frac: [f32; CHUNK],
@@ -677,6 +678,7 @@ impl Lanes {
 
             j: [[0; CHUNK]; 4],
             acc: [0.0; FLOATS],
+            #[cfg(target_arch = "x86_64")]
             padrow: Vec::new(),
         })
     }
@@ -744,50 +746,16 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, const AVX2: bool>(
     // The horizontal pass's padded source row (AVX2 build) and its padding, built for the
     // row's first chunk that passes the test.
     #[cfg(target_arch = "x86_64")]
-    let mut padrow = std::mem::take(&mut lanes.padrow);
-    #[cfg(target_arch = "x86_64")]
-    let mut padding: Option<usize> = None;
-    // A chunk of `n` pixels from `x0` through the fast path, if it passes the test.
-    let mut fast_chunk = |lanes: &mut Lanes, out: &mut RowOut, x0: usize, n: usize| {
-        if !eligible::<VERTICAL, JITTER>(pass, ctx, x0, y, n) {
-            return false;
-        }
-        #[cfg(target_arch = "x86_64")]
-        if AVX2 {
-            let pad = if VERTICAL {
-                0
-            } else {
-                *padding.get_or_insert_with(|| {
-                    let pad = row_reach(ctx, y);
-                    super::groups::pad_row(pass.src.as_flattened(), w, y, pad, &mut padrow);
-                    pad
-                })
-            };
-            let srcs = super::groups::Sources {
-                src: pass.src.as_flattened(),
-                row: &padrow,
-                pad,
-            };
-            // SAFETY: `AVX2` is only true in `row_avx2`, which is only called after checking
-            // that the CPU has AVX2 and FMA.
-            unsafe {
-                if ctx.avx512 {
-                    // (And `avx512` is only set where the CPU has AVX-512F.)
-                    super::groups16::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out)
-                } else {
-                    super::groups::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out)
-                }
-            };
-            return true;
-        }
-        sum_chunk::<VERTICAL, JITTER>(pass, ctx, lanes, x0, y, n);
-        store(out, &lanes.acc[..3 * n], x0);
-        true
+    let mut pad = PadRow {
+        row: std::mem::take(&mut lanes.padrow),
+        pad: None,
     };
+    #[cfg(not(target_arch = "x86_64"))]
+    let mut pad = PadRow;
     let (mut x0, mut fast) = (0, 0);
     while x0 < w {
         let n = CHUNK.min(w - x0);
-        if fast_chunk(lanes, &mut out, x0, n) {
+        if fast_chunk::<VERTICAL, JITTER, AVX2>(pass, ctx, lanes, &mut out, (x0, y, n), &mut pad) {
             fast += n;
         } else {
             // Near a silhouette: retry in smaller pieces (each reaches less far across the
@@ -795,7 +763,14 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, const AVX2: bool>(
             let mut s0 = x0;
             while s0 < x0 + n {
                 let k = SUBCHUNK.min(x0 + n - s0);
-                if fast_chunk(lanes, &mut out, s0, k) {
+                if fast_chunk::<VERTICAL, JITTER, AVX2>(
+                    pass,
+                    ctx,
+                    lanes,
+                    &mut out,
+                    (s0, y, k),
+                    &mut pad,
+                ) {
                     fast += k;
                 } else {
                     for x in s0..s0 + k {
@@ -810,9 +785,70 @@ fn row_any<const VERTICAL: bool, const JITTER: bool, const AVX2: bool>(
     }
     #[cfg(target_arch = "x86_64")]
     {
-        lanes.padrow = padrow;
+        lanes.padrow = pad.row;
     }
     fast
+}
+
+/// The horizontal pass's padded source row of [`row_any`] (x86-64: built for the row's
+/// first chunk that passes the test, `pad` its padding once built).
+#[cfg(target_arch = "x86_64")]
+struct PadRow {
+    row: Vec<f32>,
+    pad: Option<usize>,
+}
+
+/// (No padded row outside x86-64.)
+#[cfg(not(target_arch = "x86_64"))]
+struct PadRow;
+
+/// Sums the chunk of `n` pixels of row `y` from `x0` through the fast path if it passes the
+/// test ([`eligible`]). A function rather than a closure of [`row_any`] so that it is
+/// inlined there and compiled with its target features (a closure is compiled without).
+#[inline(always)]
+fn fast_chunk<const VERTICAL: bool, const JITTER: bool, const AVX2: bool>(
+    pass: &Pass,
+    ctx: &Ctx,
+    lanes: &mut Lanes,
+    out: &mut RowOut,
+    (x0, y, n): (usize, usize, usize),
+    #[allow(unused_variables)] padrow: &mut PadRow,
+) -> bool {
+    if !eligible::<VERTICAL, JITTER>(pass, ctx, x0, y, n) {
+        return false;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        let w = pass.input.width;
+        let pad = if VERTICAL {
+            0
+        } else {
+            *padrow.pad.get_or_insert_with(|| {
+                let pad = row_reach(ctx, y);
+                super::groups::pad_row(pass.src.as_flattened(), w, y, pad, &mut padrow.row);
+                pad
+            })
+        };
+        let srcs = super::groups::Sources {
+            src: pass.src.as_flattened(),
+            row: &padrow.row,
+            pad,
+        };
+        // SAFETY: `AVX2` is only true in `row_avx2`, which is only called after checking
+        // that the CPU has AVX2 and FMA.
+        unsafe {
+            if ctx.avx512 {
+                // (And `avx512` is only set where the CPU has AVX-512F.)
+                super::groups16::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out)
+            } else {
+                super::groups::chunk::<VERTICAL, JITTER>(pass, ctx, &srcs, x0, y, n, out)
+            }
+        };
+        return true;
+    }
+    sum_chunk::<VERTICAL, JITTER>(pass, ctx, lanes, x0, y, n);
+    store(out, &lanes.acc[..3 * n], x0);
+    true
 }
 
 /// How far (pixels) the axis taps of row `y`'s blurred pixels reach along the row, plus
