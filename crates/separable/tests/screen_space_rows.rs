@@ -258,6 +258,58 @@ fn the_fast_path_is_taken_on_clean_frames() {
 }
 
 #[test]
+fn horizontal_edges_within_the_vertical_reach_are_seen() {
+    // A horizontal strip of another object, of a raised surface and of a sunken one across
+    // the frame: the vertical pass's silhouette test reads the summary's 8-row bands, which
+    // must carry the strip's id and depths to the chunks above and below it (a band that
+    // lost either would let those chunks read across the edge, which the per-pixel form
+    // rejects). The texture makes any such read visible.
+    let (w, h) = (200, 96);
+    let strip = |y: usize| (40..56).contains(&y);
+    let mut frames = Vec::new();
+    let mut f = Frame::flat(w, h, 0.5);
+    f.set_irradiance(hash01);
+    for y in 0..h {
+        if strip(y) {
+            f.mask[y * w..(y + 1) * w].fill(1);
+        }
+    }
+    frames.push(("object strip", f));
+    for dz in [60.0, -60.0] {
+        let mut f = Frame::flat(w, h, 0.5);
+        f.set_irradiance(hash01);
+        for y in 0..h {
+            if strip(y) {
+                f.depth[y * w..(y + 1) * w].fill(1000.0 + dz);
+            }
+        }
+        frames.push((
+            if dz > 0.0 {
+                "deeper strip"
+            } else {
+                "nearer strip"
+            },
+            f,
+        ));
+    }
+    let (_, kernel) = kernels().remove(0);
+    for (name, f) in &frames {
+        for jitter in [0.0, 0.1] {
+            let opts = FilterOptions {
+                jitter_radius: jitter,
+                ..Default::default()
+            };
+            let fast = assert_same(f, &kernel, &opts, &format!("{name}, jitter {jitter}"));
+            // Rows far from the strip (and from the frame's ends) still take chunks.
+            assert!(
+                fast > 0.3 && fast < 1.0,
+                "{name}: fast path fraction {fast}"
+            );
+        }
+    }
+}
+
+#[test]
 fn taps_reaching_past_the_padded_row_fall_back_per_pixel() {
     // A frame 4200 pixels wide whose footprint is so small that the widest axis tap reaches
     // 4150 pixels: the chunks still qualify (the reach is under width + height), but the
