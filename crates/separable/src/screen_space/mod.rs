@@ -311,7 +311,8 @@ pub enum Evaluation {
     /// Row chunks with the silhouette test hoisted ([`filter_into`]).
     Rows,
     /// [`Evaluation::Rows`] in the x86-64 baseline instruction set even where AVX2 and FMA
-    /// are available (multiplies and adds not fused: the two agree within rounding).
+    /// are available (multiplies and adds not fused: the two agree within rounding), the
+    /// per-frame summary and rotation table included (the same bits either way).
     RowsBaseline,
     /// [`Evaluation::Rows`] with the 8-pixel AVX2 groups even where AVX-512 is available
     /// (the same sums: the 16-pixel groups do the same operations).
@@ -384,13 +385,19 @@ fn run(
     };
     let tables = chunked.then(|| {
         (
-            Summary::new(input, &rules, std::mem::take(&mut scratch.summary)),
+            Summary::new(
+                input,
+                &rules,
+                std::mem::take(&mut scratch.summary),
+                isa != Isa::Baseline,
+            ),
             PixelTable::new(
                 input,
                 opts.seed,
                 jitter,
                 std::mem::take(&mut scratch.rotation),
                 &mut scratch.rotation_key,
+                isa != Isa::Baseline,
             ),
         )
     });

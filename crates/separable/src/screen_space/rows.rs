@@ -322,7 +322,15 @@ impl Summary {
     /// Scans `input`'s mask, depth and footprint once (`rules`: which pixels are blurred).
     /// The summary of `input`, in `buffers` (cells, bands and the bands' working rows, from
     /// an earlier frame: every element used is written).
-    pub fn new(input: &ScreenInput, rules: &Rules, buffers: [Vec<Cell>; 3]) -> Summary {
+    ///
+    /// `simd`: build the cells with AVX2 where the CPU has it (false: the portable code
+    /// everywhere, for [`super::Evaluation::RowsBaseline`]; both give the same cells).
+    pub fn new(
+        input: &ScreenInput,
+        rules: &Rules,
+        buffers: [Vec<Cell>; 3],
+        #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))] simd: bool,
+    ) -> Summary {
         let [mut cells, mut bands, mut quads] = buffers;
         let w = input.width;
         let cols = w.div_ceil(CELL);
@@ -340,7 +348,7 @@ impl Summary {
             .enumerate()
             .for_each(|(y, row)| {
                 #[cfg(target_arch = "x86_64")]
-                if std::arch::is_x86_feature_detected!("avx2") {
+                if simd && std::arch::is_x86_feature_detected!("avx2") {
                     // SAFETY: the CPU was just checked to support AVX2, the only requirement
                     // of calling a function compiled with it.
                     return unsafe { summary_row_avx2(input, rules, y, row) };
@@ -442,12 +450,14 @@ pub(super) struct PixelTable {
 impl PixelTable {
     /// The table of `input` (rotations only when `jitter`), in `rotation`: the table of an
     /// earlier frame, kept as it is when that frame had the same size and seed (`key`).
+    /// `simd` as for [`Summary::new`] (both give the same table).
     pub fn new(
         input: &ScreenInput,
         seed: u64,
         jitter: bool,
         mut rotation: Vec<u8>,
         key: &mut Option<(usize, usize, u64)>,
+        #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))] simd: bool,
     ) -> PixelTable {
         let w = input.width;
         let now = (w, input.height, seed);
@@ -464,7 +474,7 @@ impl PixelTable {
             .enumerate()
             .for_each(|(y, row)| {
                 #[cfg(target_arch = "x86_64")]
-                if std::arch::is_x86_feature_detected!("avx2") {
+                if simd && std::arch::is_x86_feature_detected!("avx2") {
                     // SAFETY: the CPU was just checked to support AVX2, the only requirement
                     // of calling a function compiled with it.
                     return unsafe { rotation_row_avx2(y, seed, row) };
