@@ -136,6 +136,16 @@ fn min_max(v: __m256i) -> (i32, i32) {
     (_mm256_cvtsi256_si32(lo), _mm256_cvtsi256_si32(hi))
 }
 
+/// The largest of 8 u32 lanes.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn max_u32(v: __m256i) -> u32 {
+    let mut m = _mm256_max_epu32(v, _mm256_permute2x128_si256::<1>(v, v));
+    m = _mm256_max_epu32(m, _mm256_shuffle_epi32::<0b01_00_11_10>(m));
+    m = _mm256_max_epu32(m, _mm256_shuffle_epi32::<0b10_11_00_01>(m));
+    _mm256_cvtsi256_si32(m) as u32
+}
+
 /// Where a group's rows come from.
 pub(super) struct Sources<'a> {
     /// The pass's source image (RGB, row-major).
@@ -440,6 +450,8 @@ fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
     let mut fx = [[0f32; G]; NQ];
     let mut fy = [[0f32; G]; NQ];
     let mut edge = false;
+    // The largest first float of a cell (as u32: a negative one is larger than any image).
+    let mut top = _mm256_setzero_si256();
     for q in 0..NQ {
         let o = _mm256_mul_ps(_mm256_set1_ps(taps[q].0), geo.inv);
         // x − o·c, y − o·s (horizontal); x + o·s, y − o·c (vertical: the axis is (−s, c)),
@@ -471,14 +483,13 @@ fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
         edge |= _mm256_movemask_ps(outside) != 0;
         let (cxi, cyi) = (_mm256_cvttps_epi32(cx), _mm256_cvttps_epi32(cy));
         let j = _mm256_add_epi32(cxi, _mm256_mullo_epi32(cyi, wi));
+        let j3 = _mm256_add_epi32(j, _mm256_add_epi32(j, j));
+        top = _mm256_max_epu32(top, j3);
         // SAFETY: each destination holds 8 lanes.
         unsafe {
             _mm256_storeu_ps(fx[q].as_mut_ptr(), _mm256_sub_ps(sx, cx));
             _mm256_storeu_ps(fy[q].as_mut_ptr(), _mm256_sub_ps(sy, cy));
-            _mm256_storeu_si256(
-                cell[q].as_mut_ptr().cast(),
-                _mm256_add_epi32(j, _mm256_add_epi32(j, j)),
-            );
+            _mm256_storeu_si256(cell[q].as_mut_ptr().cast(), j3);
             _mm256_storeu_si256(col[q].as_mut_ptr().cast(), cxi);
             _mm256_storeu_si256(row[q].as_mut_ptr().cast(), cyi);
         }
@@ -495,12 +506,19 @@ fn rotated_batch<const VERTICAL: bool, const NQ: usize>(
     }
     let base = src.as_ptr();
     let down = 3 * w;
+    // The loads below rely on the border test above; this check backs it (a few
+    // instructions per batch), so a wrong test panics instead of reading past the image.
+    assert!(
+        max_u32(top) as usize + down + 8 <= src.len(),
+        "rotated tap cell outside the image"
+    );
     for (l, r) in rsum.iter_mut().enumerate() {
         for q in 0..NQ {
-            let j = cell[q][l] as usize;
+            let j = cell[q][l] as u32 as usize;
             // SAFETY: no cell of the batch reaches the border: each was checked inside the
             // image with 0 ≤ cx ≤ w − 3 and 0 ≤ cy ≤ h − 2, so j = 3·(cy·w + cx) and the 8
-            // floats from j + 3w end at 3·((cy + 1)·w + cx) + 8 ≤ 3·w·h − 1 < src.len().
+            // floats from j + 3w end at 3·((cy + 1)·w + cx) + 8 ≤ 3·w·h − 1 < src.len()
+            // (and the assertion above checked j + 3w + 8 ≤ src.len() for every j).
             let (a, b) = unsafe {
                 (
                     _mm256_loadu_ps(base.add(j)),

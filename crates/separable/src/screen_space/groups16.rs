@@ -412,6 +412,8 @@ fn batch16<const VERTICAL: bool, const NQ: usize>(
     let mut fx = [zero; NQ];
     let mut fy = [zero; NQ];
     let mut edge = 0u16;
+    // The largest first float of a cell (as u32: a negative one is larger than any image).
+    let mut top = _mm512_setzero_si512();
     for q in 0..NQ {
         let o = _mm512_mul_ps(_mm512_set1_ps(taps[q].0), geo.inv);
         // x − o·c, y − o·s (horizontal); x + o·s, y − o·c (vertical), as the 8-lane loop.
@@ -439,12 +441,11 @@ fn batch16<const VERTICAL: bool, const NQ: usize>(
         let j = _mm512_add_epi32(cxi, _mm512_mullo_epi32(cyi, wi));
         fx[q] = _mm512_sub_ps(sx, cx);
         fy[q] = _mm512_sub_ps(sy, cy);
+        let j3 = _mm512_add_epi32(j, _mm512_add_epi32(j, j));
+        top = _mm512_max_epu32(top, j3);
         // SAFETY: each destination holds 16 lanes.
         unsafe {
-            _mm512_storeu_si512(
-                cell[q].as_mut_ptr().cast(),
-                _mm512_add_epi32(j, _mm512_add_epi32(j, j)),
-            );
+            _mm512_storeu_si512(cell[q].as_mut_ptr().cast(), j3);
             _mm512_storeu_si512(col[q].as_mut_ptr().cast(), cxi);
             _mm512_storeu_si512(row[q].as_mut_ptr().cast(), cyi);
         }
@@ -457,13 +458,20 @@ fn batch16<const VERTICAL: bool, const NQ: usize>(
     }
     let base = src.as_ptr();
     let down = 3 * w;
+    // The loads below rely on the border test above; this check backs it, so a wrong test
+    // panics instead of reading past the image.
+    assert!(
+        _mm512_reduce_max_epu32(top) as usize + down + 8 <= src.len(),
+        "rotated tap cell outside the image"
+    );
     for (p, r) in rsum.iter_mut().enumerate() {
         let pair = index(&PAIR[p]);
         for q in 0..NQ {
             let (j0, j1) = (cell[q][2 * p] as usize, cell[q][2 * p + 1] as usize);
             // SAFETY: no cell of the batch reaches the border: each was checked inside the
             // image with 0 ≤ cx ≤ w − 3 and 0 ≤ cy ≤ h − 2, so j = 3·(cy·w + cx) and the 8
-            // floats from j + 3w end at 3·((cy + 1)·w + cx) + 8 ≤ 3·w·h − 1 < src.len().
+            // floats from j + 3w end at 3·((cy + 1)·w + cx) + 8 ≤ 3·w·h − 1 < src.len()
+            // (and the assertion above checked j + 3w + 8 ≤ src.len() for every j).
             let (a, b) = unsafe {
                 (
                     cat(_mm256_loadu_ps(base.add(j0)), _mm256_loadu_ps(base.add(j1))),

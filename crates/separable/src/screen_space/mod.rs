@@ -380,8 +380,11 @@ fn run(
             [c as f32, s as f32]
         })
         .collect();
-    // The chunked form indexes texels in i32 / u32 lanes.
-    let chunked = evaluation != Evaluation::PerPixel && n <= i32::MAX as usize;
+    // The chunked form indexes texels, and the SIMD loops their floats (3 per texel, and a
+    // row and 8 floats past a cell), in i32 / u32 lanes: larger frames (over 715 M pixels)
+    // go pixel by pixel.
+    let chunked =
+        evaluation != Evaluation::PerPixel && 3 * (n + input.width) + 8 <= i32::MAX as usize;
     let isa = match evaluation {
         Evaluation::RowsBaseline => Isa::Baseline,
         Evaluation::RowsAvx2 => Isa::Avx2,
