@@ -255,6 +255,24 @@ fn the_fast_path_is_taken_on_clean_frames() {
             assert_eq!(assert_same(&f, &kernel, &opts, name), 1.0, "{name}");
         }
     }
+    // A footprint alternating every 5 pixels between 0.25 and 0.6 mm: an axis tap's integer
+    // offsets span several values within a group of 8 or 16 pixels, so the groups go pixel
+    // by pixel inside chunks that pass the test (every tap must still be summed).
+    let mut f = Frame::flat(257, 48, 0.5);
+    f.set_irradiance(hash01);
+    for (i, m) in f.mm_per_pixel.iter_mut().enumerate() {
+        *m = if (i % 257 / 5) % 2 == 0 { 0.25 } else { 0.6 };
+    }
+    for jitter in [0.0, 0.1] {
+        let opts = FilterOptions {
+            jitter_radius: jitter,
+            ..Default::default()
+        };
+        for (name, kernel) in kernels() {
+            let what = format!("alternating footprint, {name}, jitter {jitter}");
+            assert_eq!(assert_same(&f, &kernel, &opts, &what), 1.0, "{what}");
+        }
+    }
 }
 
 #[test]
