@@ -238,39 +238,34 @@ fn the_fast_path_is_taken_on_clean_frames() {
             }
         }
     }
-    // A texture over a footprint that changes by a fraction of a pixel per chunk (the tap
-    // offsets differ across a chunk, so taps switch between the contiguous and the per-lane
-    // reads).
-    let mut f = Frame::flat(257, 64, 0.5);
-    f.set_irradiance(hash01);
-    for (i, m) in f.mm_per_pixel.iter_mut().enumerate() {
-        *m = 0.3 + 0.0007 * (i % 257) as f32;
-    }
-    for jitter in [0.0, 0.1] {
-        let opts = FilterOptions {
-            jitter_radius: jitter,
-            ..Default::default()
-        };
-        for (name, kernel) in kernels() {
-            assert_eq!(assert_same(&f, &kernel, &opts, name), 1.0, "{name}");
+    // Two footprints that vary along the row, over a texture:
+    // - changing by a fraction of a pixel per chunk (the tap offsets differ across a chunk,
+    //   so taps switch between the contiguous and the per-lane reads);
+    // - alternating every 5 pixels between 0.25 and 0.6 mm: an axis tap's integer offsets
+    //   span several values within a group of 8 or 16 pixels, so the groups go pixel by
+    //   pixel inside chunks that pass the test (every tap must still be summed).
+    type Footprint = fn(usize) -> f32;
+    let footprints: [(&str, usize, Footprint); 2] = [
+        ("sliding footprint", 64, |x| 0.3 + 0.0007 * x as f32),
+        ("alternating footprint", 48, |x| {
+            if (x / 5) % 2 == 0 { 0.25 } else { 0.6 }
+        }),
+    ];
+    for (label, height, mm) in footprints {
+        let mut f = Frame::flat(257, height, 0.5);
+        f.set_irradiance(hash01);
+        for (i, m) in f.mm_per_pixel.iter_mut().enumerate() {
+            *m = mm(i % 257);
         }
-    }
-    // A footprint alternating every 5 pixels between 0.25 and 0.6 mm: an axis tap's integer
-    // offsets span several values within a group of 8 or 16 pixels, so the groups go pixel
-    // by pixel inside chunks that pass the test (every tap must still be summed).
-    let mut f = Frame::flat(257, 48, 0.5);
-    f.set_irradiance(hash01);
-    for (i, m) in f.mm_per_pixel.iter_mut().enumerate() {
-        *m = if (i % 257 / 5) % 2 == 0 { 0.25 } else { 0.6 };
-    }
-    for jitter in [0.0, 0.1] {
-        let opts = FilterOptions {
-            jitter_radius: jitter,
-            ..Default::default()
-        };
-        for (name, kernel) in kernels() {
-            let what = format!("alternating footprint, {name}, jitter {jitter}");
-            assert_eq!(assert_same(&f, &kernel, &opts, &what), 1.0, "{what}");
+        for jitter in [0.0, 0.1] {
+            let opts = FilterOptions {
+                jitter_radius: jitter,
+                ..Default::default()
+            };
+            for (name, kernel) in kernels() {
+                let what = format!("{label}, {name}, jitter {jitter}");
+                assert_eq!(assert_same(&f, &kernel, &opts, &what), 1.0, "{what}");
+            }
         }
     }
 }

@@ -32,7 +32,7 @@ use super::rows::{ChunkTaps, Ctx, RowOut, store};
 use std::arch::x86_64::*;
 
 /// Pixels per group (one 8-lane register per channel triple of floats).
-pub(super) const G: usize = 8;
+const G: usize = 8;
 /// Rotated taps whose positions a group holds at once (more are summed in batches).
 const HELD: usize = 4;
 
@@ -340,7 +340,7 @@ pub(super) fn chunk<const VERTICAL: bool, const JITTER: bool>(
 
 /// Pixels `a..b` of row `y` through the per-pixel form.
 #[inline(never)]
-pub(super) fn pixels<const VERTICAL: bool, const JITTER: bool>(
+fn pixels<const VERTICAL: bool, const JITTER: bool>(
     pass: &Pass,
     a: usize,
     b: usize,
@@ -358,7 +358,7 @@ pub(super) fn pixels<const VERTICAL: bool, const JITTER: bool>(
 /// A batch of taps with a cell at the image border reads each pixel's four clamped texels.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
-pub(super) fn rotated<const VERTICAL: bool>(
+fn rotated<const VERTICAL: bool>(
     pass: &Pass,
     ctx: &Ctx,
     inv: __m256,

@@ -382,10 +382,7 @@ fn index(v: &[i32; 16]) -> __m512i {
 fn twice(v: &[f32; 8]) -> __m512 {
     // SAFETY: `v` holds 8 floats.
     let h = unsafe { _mm256_loadu_ps(v.as_ptr()) };
-    _mm512_castpd_ps(_mm512_insertf64x4::<1>(
-        _mm512_castpd256_pd512(_mm256_castps_pd(h)),
-        _mm256_castps_pd(h),
-    ))
+    cat(h, h)
 }
 
 /// Adds `NQ` rotated taps to the pixel pairs' sums in `rsum` (see [`rotated`]).
