@@ -27,7 +27,8 @@
 //! show one blurred object, and whose taps can only reach texels of that object within the
 //! depth threshold, runs every tap over the chunk with contiguous reads and no per-texel
 //! tests; that test is hoisted into a per-frame summary of object ids, depth ranges and
-//! footprints per 16-pixel cell (and per 8-row band), so a chunk checks a few cells. The others
+//! footprints per 16-pixel cell (and per 8-row band, and per block of 8 rows by 64 pixels,
+//! checked first), so a chunk checks a few blocks or cells. The others
 //! (near silhouettes, mixed or skipped pixels) retry as 16-pixel pieces, then go pixel by
 //! pixel (`pixel.rs`: the straightforward form, each texel tested, the reference). The chunked
 //! form computes the same taps at the same positions (each pixel's tap positions are the
@@ -260,8 +261,8 @@ impl Rules {
 #[derive(Default)]
 pub struct FilterScratch {
     image: Vec<[f32; 3]>,
-    /// The silhouette summary's cells, bands and the bands' working rows.
-    summary: [Vec<Cell>; 3],
+    /// The silhouette summary's cells, bands, the bands' working rows and blocks.
+    summary: [Vec<Cell>; 4],
     rotation: Vec<u8>,
     /// (width, height, seed) of the table in `rotation`, if it holds one.
     rotation_key: Option<(usize, usize, u64)>,

@@ -11,7 +11,9 @@
 //! centre in the chunk. That test is hoisted out of the tap loop: a [`Summary`] holds, per row
 //! and per cell of [`CELL`] pixels, whether the cell shows one object and its depth range, so
 //! a chunk checks a few cells instead of every texel of every tap (conservatively: a chunk
-//! whose reach touches a mixed cell goes pixel by pixel, through [`Pass::pixel`]).
+//! whose reach touches a mixed cell goes pixel by pixel, through [`Pass::pixel`]). Cells are
+//! joined into bands of 8 rows, and those into blocks of 64 pixels, tested first: away from
+//! silhouettes and depth steps a chunk's reach is a handful of blocks.
 //!
 //! On x86-64 with AVX2 and FMA the chunks that pass are summed by [`super::groups`]; the
 //! loops here are the portable form, for other CPUs (and `Evaluation::RowsBaseline`). The
@@ -73,7 +75,14 @@ pub(super) struct Summary {
     bands: Vec<Cell>,
     /// Working rows of the bands (combinations of 4 rows), kept for the next frame.
     quads: Vec<Cell>,
+    /// `blocks[y * blocks_per_row + b]` combines bands (y, BLOCK·b..BLOCK·(b + 1)): 8 rows
+    /// by 64 pixels, tested before the bands so a chunk far from any silhouette checks a few
+    /// blocks instead of every cell its taps reach.
+    blocks: Vec<Cell>,
 }
+
+/// Cells per block of the summary.
+const BLOCK: usize = 4;
 
 /// `dst` row y = `src` rows y and y + `step` joined, for `rows` rows of `cols` cells.
 fn join_rows(
@@ -328,10 +337,10 @@ impl Summary {
     pub fn new(
         input: &ScreenInput,
         rules: &Rules,
-        buffers: [Vec<Cell>; 3],
+        buffers: [Vec<Cell>; 4],
         #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))] simd: bool,
     ) -> Summary {
-        let [mut cells, mut bands, mut quads] = buffers;
+        let [mut cells, mut bands, mut quads, mut blocks] = buffers;
         let w = input.width;
         let cols = w.div_ceil(CELL);
         let blank = Cell {
@@ -361,25 +370,31 @@ impl Summary {
         let h = input.height;
         join_rows(&cells, &mut bands, cols, h.saturating_sub(1), 1, blank);
         join_rows(&bands, &mut quads, cols, h.saturating_sub(3), 2, blank);
-        join_rows(
-            &quads,
-            &mut bands,
-            cols,
-            (h + 1).saturating_sub(BAND),
-            4,
-            blank,
-        );
+        let band_rows = (h + 1).saturating_sub(BAND);
+        join_rows(&quads, &mut bands, cols, band_rows, 4, blank);
+        let per_row = cols.div_ceil(BLOCK);
+        blocks.resize(per_row * band_rows, blank);
+        blocks
+            .par_chunks_mut(per_row.max(1))
+            .enumerate()
+            .for_each(|(y, row)| {
+                let src = &bands[y * cols..(y + 1) * cols];
+                for (d, part) in row.iter_mut().zip(src.chunks(BLOCK)) {
+                    *d = part[1..].iter().fold(part[0], |a, c| a.join(*c));
+                }
+            });
         Summary {
             cols,
             cells,
             bands,
             quads,
+            blocks,
         }
     }
 
     /// The buffers, for the next frame.
-    pub fn into_buffers(self) -> [Vec<Cell>; 3] {
-        [self.cells, self.bands, self.quads]
+    pub fn into_buffers(self) -> [Vec<Cell>; 4] {
+        [self.cells, self.bands, self.quads, self.blocks]
     }
 
     /// The cells holding columns `xs.0..=xs.1` of row `y`.
@@ -421,13 +436,37 @@ impl Summary {
         if ys.1 + 1 - ys.0 < BAND {
             return (ys.0..=ys.1).all(|y| ok(self.cells(y, xs)));
         }
-        // Bands of BAND rows from ys.0, the last one ending at ys.1 (overlaps are harmless).
-        let (c0, c1) = (xs.0 / CELL, xs.1 / CELL);
+        // Whole blocks first: they cover the rectangle and more, so if they pass, so would
+        // its cells; if not (another object or a depth step within a block), its cells.
+        self.banded::<true>(id, ys, xs, lo, hi) || self.banded::<false>(id, ys, xs, lo, hi)
+    }
+
+    /// [`Summary::clean`] of `ys.1 + 1 − ys.0 ≥ BAND` rows through bands of BAND rows from
+    /// ys.0, the last one ending at ys.1 (overlaps are harmless), of cells or of whole
+    /// `BLOCKS` (a stricter test: blocks cover whole 64-pixel runs).
+    #[inline]
+    fn banded<const BLOCKS: bool>(
+        &self,
+        id: u32,
+        ys: (usize, usize),
+        xs: (usize, usize),
+        lo: f32,
+        hi: f32,
+    ) -> bool {
+        let (grid, per_row, span) = if BLOCKS {
+            (&self.blocks, self.cols.div_ceil(BLOCK), BLOCK * CELL)
+        } else {
+            (&self.bands, self.cols, CELL)
+        };
+        let (c0, c1) = (xs.0 / span, xs.1 / span);
         let mut y = ys.0;
         loop {
             let start = y.min(ys.1 + 1 - BAND);
-            let r = start * self.cols;
-            if !ok(&self.bands[r + c0..=r + c1]) {
+            let r = start * per_row;
+            if !grid[r + c0..=r + c1]
+                .iter()
+                .fold(true, |a, c| a & c.within(id, lo, hi))
+            {
                 return false;
             }
             if start + BAND > ys.1 {
@@ -1371,6 +1410,85 @@ mod tests {
         // Both outcomes of each test were compared.
         assert!((500..3500).contains(&uniform), "{uniform} uniform cells");
         assert!((500..3500).contains(&blurred), "{blurred} blurred cells");
+    }
+
+    /// The hoisted silhouette test is the per-pixel one over whole cells: on a frame with
+    /// another object, a background strip, a raised patch and a non-finite depth,
+    /// [`Summary::clean`] says a rectangle's cells show only `id` with finite depths in
+    /// [lo, hi] exactly when every pixel of them does, for rectangles of 1 to 40 rows, both
+    /// where the blocks pass and where only the cells do.
+    #[test]
+    fn clean_is_the_per_pixel_test() {
+        let (w, h) = (203, 70);
+        let n = w * h;
+        let mut mask = vec![1u32; n];
+        let mut depth: Vec<f32> = (0..n)
+            .map(|i| 600.0 + 0.02 * (i % w) as f32 + 0.03 * (i / w) as f32)
+            .collect();
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let (dx, dy) = (x as f32 - 120.0, y as f32 - 30.0);
+                if dx * dx + dy * dy < 90.0 {
+                    mask[i] = 2;
+                }
+                if (10..13).contains(&y) && x < 70 {
+                    mask[i] = NO_OBJECT;
+                }
+                if (40..47).contains(&x) && (50..58).contains(&y) {
+                    depth[i] += 25.0;
+                }
+            }
+        }
+        depth[66 * w + 180] = f32::NAN;
+        let mm = vec![0.5f32; n];
+        let irradiance = vec![[0.0f32; 3]; n];
+        let input = ScreenInput {
+            width: w,
+            height: h,
+            irradiance: &irradiance,
+            depth: &depth,
+            mask: &mask,
+            mm_per_pixel: &mm,
+        };
+        let rules = Rules {
+            support_mm: 14.0,
+            depth_mm: 14.0,
+            min_footprint_px: 1.0,
+        };
+        let blank = || Vec::new();
+        let s = Summary::new(&input, &rules, [blank(), blank(), blank(), blank()], true);
+        let (mut kept, mut by_cells) = (0, 0);
+        for t in 0..20_000u64 {
+            let r = |k: u64, m: usize| (sss_util::splitmix64(t * 16 + k) % m as u64) as usize;
+            let id = if r(0, 4) == 0 { 2 } else { 1 };
+            let rows = 1 + r(1, 40);
+            let y0 = r(2, h - rows + 1);
+            let x0 = r(3, w);
+            let x1 = (x0 + r(4, 120)).min(w - 1);
+            let (ys, xs) = ((y0, y0 + rows - 1), (x0, x1));
+            let lo = 600.0 + r(5, 6) as f32;
+            let hi = lo + [3.0, 10.0, 30.0][r(6, 3)];
+            // Every pixel of the cells holding columns x0..=x1.
+            let expected = (ys.0..=ys.1).all(|y| {
+                (x0 / CELL * CELL..((x1 / CELL + 1) * CELL).min(w)).all(|x| {
+                    let (m, d) = (mask[y * w + x], depth[y * w + x]);
+                    m == id && d.is_finite() && d >= lo && d <= hi
+                })
+            });
+            let got = s.clean(id, ys, xs, lo, hi);
+            assert_eq!(
+                got, expected,
+                "id {id}, rows {ys:?}, columns {xs:?}, [{lo}, {hi}]"
+            );
+            kept += usize::from(got);
+            if got && rows >= BAND && !s.banded::<true>(id, ys, xs, lo, hi) {
+                by_cells += 1;
+            }
+        }
+        // Both outcomes, and rectangles that only the cells' test keeps.
+        assert!((2_000..18_000).contains(&kept), "{kept} rectangles kept");
+        assert!(by_cells >= 200, "{by_cells} kept by the cells only");
     }
 
     /// The AVX2 rotation table is the scalar hash, pixel for pixel: row lengths around the
