@@ -75,7 +75,7 @@ pub(super) struct Summary {
     bands: Vec<Cell>,
     /// Working rows of the bands (combinations of 4 rows), kept for the next frame.
     quads: Vec<Cell>,
-    /// `blocks[y * blocks_per_row + b]` combines bands (y, BLOCK·b..BLOCK·(b + 1)): 8 rows
+    /// `blocks[y * ⌈cols / BLOCK⌉ + b]` combines bands (y, BLOCK·b..BLOCK·(b + 1)): 8 rows
     /// by 64 pixels, tested before the bands so a chunk far from any silhouette checks a few
     /// blocks instead of every cell its taps reach.
     blocks: Vec<Cell>,
