@@ -140,6 +140,12 @@ impl Cell {
     fn within(&self, id: u32, lo: f32, hi: f32) -> bool {
         self.uniform & (self.id == id) & (self.dmin >= lo) & (self.dmax <= hi)
     }
+
+    /// Whether every cell of `cells` is [`Cell::within`] (no early exit: the fold vectorises).
+    #[inline(always)]
+    fn all_within(cells: &[Cell], id: u32, lo: f32, hi: f32) -> bool {
+        cells.iter().fold(true, |a, c| a & c.within(id, lo, hi))
+    }
 }
 
 /// A key of f32 bits that orders like the floats (negative ones reversed below the
@@ -432,9 +438,8 @@ impl Summary {
     /// their cells) shows object `id` with a depth in [lo, hi].
     #[inline]
     fn clean(&self, id: u32, ys: (usize, usize), xs: (usize, usize), lo: f32, hi: f32) -> bool {
-        let ok = |cells: &[Cell]| cells.iter().fold(true, |a, c| a & c.within(id, lo, hi));
         if ys.1 + 1 - ys.0 < BAND {
-            return (ys.0..=ys.1).all(|y| ok(self.cells(y, xs)));
+            return (ys.0..=ys.1).all(|y| Cell::all_within(self.cells(y, xs), id, lo, hi));
         }
         // Whole blocks first: they cover the rectangle and more, so if they pass, so would
         // its cells; if not (another object or a depth step within a block), its cells.
@@ -463,10 +468,7 @@ impl Summary {
         loop {
             let start = y.min(ys.1 + 1 - BAND);
             let r = start * per_row;
-            if !grid[r + c0..=r + c1]
-                .iter()
-                .fold(true, |a, c| a & c.within(id, lo, hi))
-            {
+            if !Cell::all_within(&grid[r + c0..=r + c1], id, lo, hi) {
                 return false;
             }
             if start + BAND > ys.1 {
@@ -1456,8 +1458,7 @@ mod tests {
             depth_mm: 14.0,
             min_footprint_px: 1.0,
         };
-        let blank = || Vec::new();
-        let s = Summary::new(&input, &rules, [blank(), blank(), blank(), blank()], true);
+        let s = Summary::new(&input, &rules, Default::default(), true);
         let (mut kept, mut by_cells) = (0, 0);
         for t in 0..20_000u64 {
             let r = |k: u64, m: usize| (sss_util::splitmix64(t * 16 + k) % m as u64) as usize;
