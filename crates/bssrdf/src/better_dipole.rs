@@ -48,7 +48,7 @@ impl Channel {
         if self.alpha_p <= 0.0 {
             return 0.0;
         }
-        let (dr, dv) = (r.hypot(self.z_r), r.hypot(self.z_v));
+        let (dr, dv) = (distance(r, self.z_r), distance(r, self.z_v));
         let (er, ev) = ((-self.sigma_tr * dr).exp(), (-self.sigma_tr * dv).exp());
         let phi = self.c_phi / self.d * (er / dr - ev / dv).max(0.0);
         let flux = self.c_e
@@ -60,7 +60,7 @@ impl Channel {
 
 impl ClosedFormTail for Channel {
     fn tail(&self, r: f64) -> f64 {
-        let (dr, dv) = (r.hypot(self.z_r), r.hypot(self.z_v));
+        let (dr, dv) = (distance(r, self.z_r), distance(r, self.z_v));
         // d_v − d_r without cancellation.
         let gap = (self.z_v - self.z_r) * (self.z_v + self.z_r) / (dv + dr);
         let phi = self.c_phi / (2.0 * self.d) * exp_diff_over_sigma(self.sigma_tr, dr, dr + gap);

@@ -32,7 +32,7 @@ struct Channel {
 
 impl Channel {
     fn term(&self, z: f64, r: f64) -> f64 {
-        let d = r.hypot(z);
+        let d = distance(r, z);
         let s = self.sigma_tr * d;
         z * (1.0 + s) * (-s).exp() / (d * d * d)
     }
@@ -50,7 +50,7 @@ impl Channel {
 impl ClosedFormTail for Channel {
     fn tail(&self, r: f64) -> f64 {
         let t = |z: f64| {
-            let d = r.hypot(z);
+            let d = distance(r, z);
             z / d * (-self.sigma_tr * d).exp()
         };
         0.5 * self.alpha_p * (t(self.z_r) + t(self.z_v))

@@ -94,6 +94,7 @@ fn filter_and_diff_refuse_layers_of_different_sizes() {
     assert!(!out.exists());
     let o = sss(&["diff", input_s, input_s, "--layer", "irradiance"]);
     assert_input_error(&o, input_s);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Runs `sss` with `args`, killing it after `limit`; `None` when it did not finish in time.
@@ -148,4 +149,5 @@ fn profile_plot_with_a_subnormal_r_max_finishes() {
     assert!(o.status.success(), "{err}");
     assert!(String::from_utf8_lossy(&o.stdout).starts_with("# total_diffuse_reflectance="));
     assert!(plot.metadata().is_ok_and(|m| m.len() > 0));
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -61,4 +61,5 @@ fn log_axes_over_subnormal_and_huge_values_finish() {
             path.display()
         );
     }
+    let _ = std::fs::remove_dir_all(&dir);
 }

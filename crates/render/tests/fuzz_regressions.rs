@@ -67,6 +67,7 @@ fn layers_of_different_sizes_are_an_error_not_a_wrong_size() {
         assert!(msg.contains("same size"), "{msg}");
         assert!(matches!(e, sss_render::Error::Input(_)), "{e:?}");
     }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Layers of one size still read, with that size; a non-RGB layer of another size neither
@@ -86,4 +87,5 @@ fn layers_of_one_size_still_read() {
     write_exr(&path, 3, 2, &[("total", &px), ("subsurface", &px)]).unwrap();
     let (w, h, layers) = read_exr(&path).unwrap();
     assert_eq!((w, h, layers.len()), (3, 2, 2));
+    let _ = std::fs::remove_dir_all(&dir);
 }
