@@ -4,6 +4,9 @@
 //! and run to run; plus the frame's shared pieces (irradiance samples built once, the radial
 //! model request, the transmitted irradiance and exit weight).
 
+mod common;
+
+use common::cheap;
 use glam::DVec3;
 use sss_bssrdf::ModelKind;
 use sss_bssrdf::fresnel::ft_dielectric;
@@ -49,17 +52,6 @@ impl Progress for Count {
     }
     fn advance(&self, n: u64) {
         self.done.fetch_add(n, Ordering::Relaxed);
-    }
-}
-
-/// Cheap options per method for the contract runs.
-fn cheap(name: &str) -> MethodOptions {
-    match name {
-        "exact" => MethodOptions::new().with("spacing", 2.0),
-        "pathtrace" => MethodOptions::new().with("spp", 2),
-        "single-tree" | "dual-tree" => MethodOptions::new().with("spacing", 2.0),
-        "mdlc" | "eelc" => MethodOptions::new().with("irradiance-points", 32),
-        _ => MethodOptions::new(),
     }
 }
 

@@ -8,9 +8,12 @@
 //! `render`'s assembly counts non-finite values as 0 and would hide a NaN, and on every layer of
 //! the render output.
 
+mod common;
+
+use common::cheap;
 use glam::DVec3;
 use sss_render::frame::Frame;
-use sss_render::integrators::{self, METHODS, MethodOptions};
+use sss_render::integrators::{self, METHODS};
 use sss_render::progress::NoProgress;
 use sss_render::render::{RenderOutput, RenderSettings, render};
 use sss_render::scene::{LoadOptions, Scene, SceneError, SceneErrorKind, load_str};
@@ -25,19 +28,6 @@ fn temp_dir(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("create temp dir");
     dir
-}
-
-/// Cheap options per method (as in the integrator contract test).
-fn cheap(name: &str) -> MethodOptions {
-    match name {
-        // The point-based methods on the same (coarse) irradiance samples.
-        "exact" | "single-tree" | "dual-tree" => MethodOptions::new().with("spacing", 2.0),
-        "pathtrace" => MethodOptions::new().with("spp", 2),
-        // The baselines draw 4096 irradiance points per shading point by default (12 s a
-        // render of this 24×18 frame); the cases here need finite values, not accuracy.
-        "mdlc" | "eelc" => MethodOptions::new().with("irradiance-points", 32),
-        _ => MethodOptions::new(),
-    }
 }
 
 /// A scene of a 24×18 camera at `camera`, looking at the origin, the given light and object
