@@ -523,3 +523,45 @@ pub(super) fn is_closed(triangles: &[[u32; 3]]) -> bool {
     }
     !count.is_empty() && count.values().all(|&c| c == 2)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The noise's lattice values along each axis on its own (the other two coordinates
+    /// fixed) look like independent uniforms on [0, 1): all distinct, mean 1/2 and lag-one
+    /// correlation 0, each within 5 standard deviations (1/√(12 n) and 1/√n).
+    #[test]
+    fn lattice_values_are_independent_uniforms_along_each_axis() {
+        let n = 4096;
+        for axis in 0..3 {
+            for (seed, fixed) in [(1u64, 0i64), (7, -3), (u64::MAX, 1 << 40)] {
+                let v: Vec<f64> = (-(n as i64) / 2..n as i64 / 2)
+                    .map(|k| {
+                        let mut c = [fixed; 3];
+                        c[axis] = k;
+                        lattice(seed, c[0], c[1], c[2])
+                    })
+                    .collect();
+                assert!(v.iter().all(|x| (0.0..1.0).contains(x)));
+                let mut sorted = v.clone();
+                sorted.sort_by(f64::total_cmp);
+                sorted.dedup();
+                assert_eq!(sorted.len(), n, "axis {axis}, seed {seed}: repeated values");
+                let nf = n as f64;
+                let mean = v.iter().sum::<f64>() / nf;
+                assert!((mean - 0.5).abs() < 5.0 / (12.0 * nf).sqrt(), "mean {mean}");
+                let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / nf;
+                let lag = v
+                    .windows(2)
+                    .map(|w| (w[0] - mean) * (w[1] - mean))
+                    .sum::<f64>();
+                let rho = lag / ((nf - 1.0) * var);
+                assert!(
+                    rho.abs() < 5.0 / nf.sqrt(),
+                    "axis {axis}: correlation {rho}"
+                );
+            }
+        }
+    }
+}

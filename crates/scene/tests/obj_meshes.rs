@@ -56,11 +56,30 @@ fn obj_meshes_load() {
     assert!((volume(m) - 1.0).abs() < 1e-7);
     assert!((area(m) - 6.0).abs() < 1e-7);
 
-    // Normals from `vn` are used as given (normalised).
-    let with_vn = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 2\nf 1//1 2//1 3//1\n";
+    // Normals from `vn` are used as given (normalised), each at its own corner, also where
+    // they are not the face's normal.
+    let with_vn = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 2\nvn 1 0 1\nvn 0 1 1\nf 1//1 2//2 3//3\n";
     std::fs::write(dir.join("vn.obj"), with_vn).unwrap();
     let s = load_in(&dir, &mesh_scene("vn.obj"), &no_dirs()).unwrap();
-    assert!(s.objects[0].mesh.normals.iter().all(|n| *n == DVec3::Z));
+    let m = &s.objects[0].mesh;
+    let given = |p: DVec3| {
+        let n = DVec3::new(p.x, p.y, 1.0);
+        n / n.length()
+    };
+    assert_eq!(m.positions.len(), 3);
+    for (p, n) in m.positions.iter().zip(&m.normals) {
+        assert!((*n - given(*p)).length() < 1e-12, "{p}: {n}");
+    }
+    // Relative (negative) indices count back from the line: the same triangle and normals.
+    let relative =
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 2\nvn 1 0 1\nvn 0 1 1\nf -3//-3 -2//-2 -1//-1\n";
+    std::fs::write(dir.join("relative.obj"), relative).unwrap();
+    let s = load_in(&dir, &mesh_scene("relative.obj"), &no_dirs()).unwrap();
+    let r = &s.objects[0].mesh;
+    assert_eq!(
+        (&r.positions, &r.normals, &r.triangles),
+        (&m.positions, &m.normals, &m.triangles)
+    );
 
     // Faces without normals among ones with: the `vn` are ignored, normals computed.
     let mixed = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 1 0 0\nf 1//1 2//1 3//1\nf 2 4 3\n";
@@ -90,6 +109,39 @@ fn obj_meshes_load() {
     assert!(volume(&s.objects[0].mesh) > 0.0);
     assert_eq!(s.warnings.len(), 1);
     assert!(s.warnings[0].contains("inverted.obj") && s.warnings[0].contains("reversed"));
+    // The same with a `vn` per vertex: turned around, each corner keeps its own normal.
+    let normals = [
+        [-1.0, -1.0, -1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let mut text: String = inverted
+        .lines()
+        .filter(|l| l.starts_with("v "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    for n in normals {
+        text += &format!("vn {} {} {}\n", n[0], n[1], n[2]);
+    }
+    for l in inverted.lines().filter(|l| l.starts_with("f ")) {
+        let corners: Vec<String> = l[2..].split(' ').map(|i| format!("{i}//{i}")).collect();
+        text += &format!("f {}\n", corners.join(" "));
+    }
+    std::fs::write(dir.join("inverted-vn.obj"), text).unwrap();
+    let s = load_in(&dir, &mesh_scene("inverted-vn.obj"), &no_dirs()).unwrap();
+    let m = &s.objects[0].mesh;
+    assert!(volume(m) > 0.0);
+    assert_eq!(m.positions.len(), 4);
+    let corners = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+    for (p, n) in m.positions.iter().zip(&m.normals) {
+        let i = corners
+            .iter()
+            .position(|c| c == p)
+            .expect("a tetrahedron corner");
+        let want = DVec3::from_array(normals[i]).normalize();
+        assert!((*n - want).length() < 1e-12, "{p}: {n}, want {want}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&other);
 }
@@ -134,7 +186,7 @@ fn obj_degenerate_triangles_are_dropped_and_counted() {
 #[test]
 fn obj_errors_name_the_file_and_line() {
     let dir = temp_dir("obj-errors");
-    let cases: [(&str, &str, usize, &[&str]); 6] = [
+    let cases: [(&str, &str, usize, &[&str]); 8] = [
         (
             "nan.obj",
             "v 0 0 0\nv 1 0 0\n# c\nv 0 nan 0\nf 1 2 3\n",
@@ -164,6 +216,18 @@ fn obj_errors_name_the_file_and_line() {
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n",
             5,
             &["out of range", "9"],
+        ),
+        (
+            "behind.obj",
+            "v 0 0 0\nv 1 0 0\nf -3 -2 -1\nv 0 1 0\n",
+            3,
+            &["out of range", "-3", "2 before this line"],
+        ),
+        (
+            "behind-vn.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//-1 2//-1 3//-2\n",
+            5,
+            &["normal index -2", "out of range", "1 before this line"],
         ),
         (
             "short.obj",

@@ -281,9 +281,13 @@ fn analytic_curvature_follows_the_transform() {
         Some(Curvature::Uniform(k)) => assert!((k - 2.0 / 3.0).abs() < 1e-12, "{k}"),
         other => panic!("{other:?}"),
     }
-    let (c, _) =
-        curvature_of("shape = \"sphere\"\nradius = 0.5\ntransform = { scale = [1.0, 2.0, 1.0] }");
-    assert_eq!(c, None);
+    // Non-uniform along any one axis: no closed form.
+    for scale in ["[1.0, 2.0, 1.0]", "[1.0, 1.0, 2.0]", "[2.0, 1.0, 1.0]"] {
+        let (c, _) = curvature_of(&format!(
+            "shape = \"sphere\"\nradius = 0.5\ntransform = {{ scale = {scale} }}"
+        ));
+        assert_eq!(c, None, "scale {scale}");
+    }
     let (c, _) = curvature_of("shape = \"plane\"\nsize = [2.0, 3.0]");
     assert_eq!(c, Some(Curvature::Uniform(0.0)));
     let (c, _) = curvature_of("shape = \"box\"\nsize = [1.0, 2.0, 3.0]");

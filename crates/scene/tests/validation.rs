@@ -194,6 +194,22 @@ fn good_scene_loads() {
         panic!()
     };
     assert!((t.medium.sigma_s_reduced(0) - 0.74).abs() < 1e-12);
+    // A light may be dark in some channels (≥ 0, not > 0): a red point light.
+    let s = load_str(
+        &with(
+            "intensity = [10.0, 10.0, 10.0]",
+            "intensity = [10.0, 0.0, 0.0]",
+        ),
+        "good.toml",
+        None,
+        &no_dirs(),
+    )
+    .unwrap();
+    assert!(
+        matches!(s.lights[0], Light::Point { intensity, .. } if intensity == [10.0, 0.0, 0.0]),
+        "{:?}",
+        s.lights[0]
+    );
 }
 
 #[test]

@@ -44,15 +44,22 @@ pub(super) fn assign_areas(mesh: &Mesh, strata: &Strata, grid: &Grid) -> Vec<f64
     let mut comp = vec![0.0f64; grid.samples.len()];
     for &(s, a) in per_unit.iter().flatten() {
         let s = s as usize;
-        let t = sum[s] + a;
-        if sum[s].abs() >= a.abs() {
-            comp[s] += (sum[s] - t) + a;
-        } else {
-            comp[s] += (a - t) + sum[s];
-        }
-        sum[s] = t;
+        neumaier_add(&mut sum[s], &mut comp[s], a);
     }
     sum.iter().zip(&comp).map(|(s, c)| s + c).collect()
+}
+
+/// Adds `a` to the running sum `sum` whose lost low-order part is `comp` (Neumaier 1974,
+/// "Rundungsfehleranalyse einiger Verfahren zur Summation endlicher Summen", ZAMM 54):
+/// the compensated total is `sum + comp`.
+fn neumaier_add(sum: &mut f64, comp: &mut f64, a: f64) {
+    let t = *sum + a;
+    if sum.abs() >= a.abs() {
+        *comp += (*sum - t) + a;
+    } else {
+        *comp += (a - t) + *sum;
+    }
+    *sum = t;
 }
 
 #[cfg(test)]
@@ -62,6 +69,32 @@ mod tests {
     use glam::DVec3;
     use rand::SeedableRng;
     use rand_pcg::Pcg64Mcg;
+
+    /// Sums whose plain f64 total loses everything: each is exact with the compensation.
+    #[test]
+    fn neumaier_sums_are_exact_where_plain_sums_fail() {
+        let total = |xs: &[f64]| {
+            let (mut s, mut c) = (0.0, 0.0);
+            for &a in xs {
+                neumaier_add(&mut s, &mut c, a);
+            }
+            s + c
+        };
+        // Neumaier's example (both branches): the plain sum gives 0.
+        let xs = [1.0, 1e100, 1.0, -1e100];
+        assert_eq!(total(&xs), 2.0);
+        assert_eq!(xs.iter().sum::<f64>(), 0.0);
+        // Small terms first, then large ones (the ulp of 1e17 is 16): plain gives 0.
+        let xs = [1.0, 1.0, 1e17, -1e17];
+        assert_eq!(total(&xs), 2.0);
+        assert_eq!(xs.iter().sum::<f64>(), 0.0);
+        // 1 + 10⁶ × 2⁻⁵³ ones: each is lost against 1 in plain summation.
+        let mut xs = vec![1.0];
+        xs.extend(std::iter::repeat_n(f64::EPSILON / 2.0, 1_000_000));
+        let exact = 1.0 + 1e6 * f64::EPSILON / 2.0;
+        assert_eq!(total(&xs), exact);
+        assert_eq!(xs.iter().sum::<f64>(), 1.0);
+    }
 
     /// The areas approximate the restricted Voronoi cells: with cells of size r/5 they are
     /// within a few percent (rms) of a 8x finer reference, far below the natural spread of

@@ -279,4 +279,71 @@ mod tests {
             assert_eq!(g.nearest(p), brute);
         }
     }
+
+    fn grid_of(points: &[DVec3], r: f64) -> Grid {
+        let mut g = Grid::new(DVec3::ZERO, r);
+        for (i, &p) in points.iter().enumerate() {
+            g.insert(Accepted {
+                triangle: i as u32,
+                u: 0.0,
+                v: 0.0,
+                position: p,
+            });
+        }
+        g
+    }
+
+    /// The brute-force nearest sample, ties to the lower index.
+    fn brute_nearest(g: &Grid, p: DVec3) -> u32 {
+        let d = |s: u32| g.samples[s as usize].position.distance_squared(p);
+        (0..g.samples.len() as u32)
+            .min_by(|&a, &b| d(a).total_cmp(&d(b)).then(a.cmp(&b)))
+            .expect("a sample")
+    }
+
+    /// `nearest_with` (the 27 cells around a point, the full search when their best is
+    /// farther than a cell) against brute force, with samples sparse enough (about two
+    /// cells apart) that a point's best neighbour is often not provably the nearest.
+    #[test]
+    fn nearest_with_matches_brute_force_on_sparse_samples() {
+        let mut rng = Pcg64Mcg::seed_from_u64(8);
+        let pts: Vec<DVec3> = (0..40)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random::<f64>() * 0.1))
+            .collect();
+        let g = grid_of(&pts, 0.1);
+        let mut nb = Vec::new();
+        let (mut full, mut quick) = (0, 0);
+        for _ in 0..4000 {
+            let p = DVec3::new(rng.random(), rng.random(), rng.random::<f64>() * 0.1);
+            g.neighbourhood(g.cell_of(p), &mut nb);
+            let got = g.nearest_with(p, &nb);
+            assert_eq!(got, brute_nearest(&g, p), "{p}");
+            // Both ways are exercised: some answers come from the neighbours alone.
+            let near = nb
+                .iter()
+                .any(|q| q.1.distance_squared(p) <= g.cell * g.cell);
+            if near { quick += 1 } else { full += 1 }
+        }
+        assert!(quick > 100 && full > 100, "{quick} quick, {full} full");
+    }
+
+    /// Exact ties go to the lower index, in both searches, whatever the insertion order.
+    #[test]
+    fn nearest_ties_go_to_the_lower_index() {
+        // p = (0.25, 0.25, 0) is at exactly 0.125 (squared 1/64) from both samples.
+        let (a, b) = (DVec3::new(0.25, 0.375, 0.0), DVec3::new(0.25, 0.125, 0.0));
+        let p = DVec3::new(0.25, 0.25, 0.0);
+        assert_eq!(a.distance_squared(p), b.distance_squared(p));
+        for pts in [[a, b], [b, a]] {
+            let g = grid_of(&pts, 0.25);
+            let mut nb = Vec::new();
+            g.neighbourhood(g.cell_of(p), &mut nb);
+            assert_eq!(nb.len(), 2);
+            assert_eq!(g.nearest(p), 0);
+            assert_eq!(g.nearest_with(p, &nb), 0);
+            // And in the order the neighbour list happens to have, reversed.
+            nb.reverse();
+            assert_eq!(g.nearest_with(p, &nb), 0);
+        }
+    }
 }

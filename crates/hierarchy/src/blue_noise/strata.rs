@@ -56,7 +56,8 @@ pub(super) struct Unit {
 /// One cell of a half.
 #[derive(Clone, Copy)]
 pub(super) struct StratumCell {
-    /// Unique within the triangle.
+    /// The cell's index within its triangle: the ids of a triangle's cells are
+    /// `0..` its cell count, each once.
     pub(super) id: u64,
     pub(super) i: u32,
     pub(super) j: u32,
@@ -297,8 +298,11 @@ mod tests {
                     "area {k}"
                 );
                 ids[k].sort_unstable();
-                ids[k].dedup();
-                assert_eq!(ids[k].len() as u64, counts[k]);
+                assert!(
+                    ids[k].iter().copied().eq(0..counts[k]),
+                    "cell ids of triangle {k} are not 0..{}",
+                    counts[k]
+                );
             }
             let total: u64 = counts.iter().sum();
             assert_eq!(total, strata.total);
