@@ -71,8 +71,8 @@ fn obj_meshes_load() {
         assert!((*n - given(*p)).length() < 1e-12, "{p}: {n}");
     }
     // Relative (negative) indices count back from the line: the same triangle and normals.
-    let relative =
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 2\nvn 1 0 1\nvn 0 1 1\nf -3//-3 -2//-2 -1//-1\n";
+    let relative = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 2\nvn 1 0 1\nvn 0 1 1\n\
+                    f -3/-3/-3 -2/-2/-2 -1/-1/-1\n";
     std::fs::write(dir.join("relative.obj"), relative).unwrap();
     let s = load_in(&dir, &mesh_scene("relative.obj"), &no_dirs()).unwrap();
     let r = &s.objects[0].mesh;
@@ -109,6 +109,28 @@ fn obj_meshes_load() {
     assert!(volume(&s.objects[0].mesh) > 0.0);
     assert_eq!(s.warnings.len(), 1);
     assert!(s.warnings[0].contains("inverted.obj") && s.warnings[0].contains("reversed"));
+    // Point (`p`) and line (`l`) elements are ignored, polylines too: only the faces make
+    // triangles.
+    std::fs::write(
+        dir.join("points.obj"),
+        format!("{TETRA}p 1 2\nl 1 2\n  l 1 2 3 4\n"),
+    )
+    .unwrap();
+    let s = load_in(&dir, &mesh_scene("points.obj"), &no_dirs()).unwrap();
+    assert_eq!(s.objects[0].mesh.triangles.len(), 4);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    // An open surface is never turned around, whatever the sign of Σ a·(b × c): this
+    // triangle's is −1, and it keeps its winding (normal −z) without a warning.
+    std::fs::write(dir.join("open.obj"), "v 0 0 1\nv 0 1 1\nv 1 0 1\nf 1 2 3\n").unwrap();
+    let s = load_in(&dir, &mesh_scene("open.obj"), &no_dirs()).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert!(
+        s.objects[0]
+            .mesh
+            .normals
+            .iter()
+            .all(|n| (*n + DVec3::Z).length() < 1e-12)
+    );
     // The same with a `vn` per vertex: turned around, each corner keeps its own normal.
     let normals = [
         [-1.0, -1.0, -1.0],
@@ -186,12 +208,24 @@ fn obj_degenerate_triangles_are_dropped_and_counted() {
 #[test]
 fn obj_errors_name_the_file_and_line() {
     let dir = temp_dir("obj-errors");
-    let cases: [(&str, &str, usize, &[&str]); 8] = [
+    let cases: [(&str, &str, usize, &[&str]); 10] = [
         (
             "nan.obj",
             "v 0 0 0\nv 1 0 0\n# c\nv 0 nan 0\nf 1 2 3\n",
             4,
-            &["nan", "not finite"],
+            &["vertex coordinate", "nan", "not finite"],
+        ),
+        (
+            "vn-nan.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 nan 1\nf 1//1 2//1 3//1\n",
+            4,
+            &["normal coordinate", "nan", "not finite"],
+        ),
+        (
+            "no-vertex.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf /1 2 3\n",
+            5,
+            &["malformed face index", "/1"],
         ),
         (
             "inf.obj",

@@ -6,7 +6,7 @@ mod common;
 
 use common::{HEAD, area, bbox, check_mesh, no_dirs, volume};
 use glam::DVec3;
-use sss_scene::{Mesh, load_str};
+use sss_scene::{Mesh, Texture, load_str};
 use std::f64::consts::PI;
 
 /// The world-space mesh of a scene made of [`HEAD`] and one object with `body` (the lines
@@ -161,6 +161,21 @@ fn bumpy_sphere_is_displaced_smoothly_and_deterministically() {
     let spread = radii.iter().cloned().fold(0.0, f64::max)
         - radii.iter().cloned().fold(f64::INFINITY, f64::min);
     assert!(spread > 0.1, "the surface is displaced ({spread})");
+    // Displaced by amplitude·(2n − 1), n the value noise at frequency·u: the noise texture
+    // at scale 1/frequency gives n (within rounding: it divides by the scale).
+    let noise = Texture::Noise {
+        scale: 1.0 / 3.0,
+        seed: 7,
+        a: [0.0; 3],
+        b: [1.0; 3],
+    };
+    for (p, r) in m.positions.iter().zip(&radii) {
+        let n = noise.eval(*p / *r)[0];
+        assert!(
+            (r - (2.0 + 0.2 * (2.0 * n - 1.0))).abs() < 1e-9,
+            "{p}: {r}, noise {n}"
+        );
+    }
     assert!(volume(&m) > 0.0);
     for (p, n) in m.positions.iter().zip(&m.normals) {
         assert!(n.dot(*p) > 0.0, "outward");

@@ -194,6 +194,26 @@ fn good_scene_loads() {
         panic!()
     };
     assert!((t.medium.sigma_s_reduced(0) - 0.74).abs() < 1e-12);
+    // A quad is degenerate when its edges are parallel relative to their lengths, at any
+    // scale: sin θ = 10⁻¹⁴ is refused and 10⁻⁹ accepted, for edges of 10⁻⁶ to 10⁶.
+    for s in [1e-6, 1.0, 1e6] {
+        for (sin, ok) in [(1e-14, false), (1e-9, true)] {
+            let text = with(
+                "edge_v = [2.0, 0.0, 0.0]",
+                &format!("edge_v = [{:e}, {:e}, 0.0]", 1000.0 * s, 1000.0 * sin * s),
+            )
+            .replace(
+                "edge_u = [0.0, 0.0, 2.0]",
+                &format!("edge_u = [{s:e}, 0.0, 0.0]"),
+            );
+            let got = load_str(&text, "good.toml", None, &no_dirs());
+            match (ok, got) {
+                (true, Ok(_)) => {}
+                (false, Err(e)) => assert!(e.to_string().contains("parallel"), "{e}"),
+                (_, got) => panic!("scale {s}, sin {sin}: {:?}", got.map(|_| "loaded")),
+            }
+        }
+    }
     // A light may be dark in some channels (≥ 0, not > 0): a red point light.
     let s = load_str(
         &with(

@@ -129,6 +129,23 @@ fn check_lines(file: &str, text: &str) -> Result<bool, SceneError> {
     Ok(corners > 0 && corners_with_normal == corners)
 }
 
+/// `bytes` with every point (`p`) and line (`l`) element emptied, the line breaks kept (so
+/// line numbers do not move).
+fn without_points_and_lines(bytes: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(bytes.len());
+    for line in bytes.split_inclusive(|&b| b == b'\n') {
+        let tag = line
+            .split(|b| b.is_ascii_whitespace())
+            .find(|t| !t.is_empty());
+        if matches!(tag, Some(b"p") | Some(b"l")) {
+            out.extend(line.iter().filter(|&&b| b == b'\n' || b == b'\r'));
+        } else {
+            out.extend_from_slice(line);
+        }
+    }
+    out
+}
+
 /// Reads an OBJ file's bytes (`file` names it in errors): checks the lines, loads the
 /// geometry with tobj (polygons fanned into triangles, all groups and objects merged into one
 /// mesh, materials ignored), keeps `vn` normals when every face corner has one, and reverses
@@ -146,7 +163,10 @@ pub(crate) fn parse(file: &str, bytes: &[u8]) -> Result<ObjMesh, SceneError> {
         ignore_lines: true,
         ..Default::default()
     };
-    let (models, _materials) = tobj::load_obj_buf(&mut &bytes[..], &options, |_| {
+    // tobj's `ignore_lines` drops two-vertex lines only: a polyline `l 1 2 3` would come
+    // back as a triangle. Point and line elements are blanked before it reads the file.
+    let faces_only = without_points_and_lines(bytes);
+    let (models, _materials) = tobj::load_obj_buf(&mut &faces_only[..], &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| invalid(file, None, format!("malformed OBJ: {e}")))?;
