@@ -138,19 +138,10 @@ fn obj_meshes_load() {
         [0.0, 1.0, 0.0],
         [0.0, 0.0, 1.0],
     ];
-    let mut text: String = inverted
-        .lines()
-        .filter(|l| l.starts_with("v "))
-        .map(|l| format!("{l}\n"))
-        .collect();
-    for n in normals {
-        text += &format!("vn {} {} {}\n", n[0], n[1], n[2]);
-    }
-    for l in inverted.lines().filter(|l| l.starts_with("f ")) {
-        let corners: Vec<String> = l[2..].split(' ').map(|i| format!("{i}//{i}")).collect();
-        text += &format!("f {}\n", corners.join(" "));
-    }
-    std::fs::write(dir.join("inverted-vn.obj"), text).unwrap();
+    let inverted_vn = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+                       vn -1 -1 -1\nvn 1 0 0\nvn 0 1 0\nvn 0 0 1\n\
+                       f 1//1 2//2 3//3\nf 1//1 4//4 2//2\nf 1//1 3//3 4//4\nf 2//2 4//4 3//3\n";
+    std::fs::write(dir.join("inverted-vn.obj"), inverted_vn).unwrap();
     let s = load_in(&dir, &mesh_scene("inverted-vn.obj"), &no_dirs()).unwrap();
     let m = &s.objects[0].mesh;
     assert!(volume(m) > 0.0);

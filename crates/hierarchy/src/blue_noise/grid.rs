@@ -257,29 +257,17 @@ mod tests {
     #[test]
     fn nearest_matches_brute_force() {
         let mut rng = Pcg64Mcg::seed_from_u64(5);
-        let mut g = Grid::new(DVec3::ZERO, 0.1);
-        for i in 0..200 {
-            let p = DVec3::new(rng.random(), rng.random(), rng.random::<f64>() * 0.1);
-            g.insert(Accepted {
-                triangle: i,
-                u: 0.0,
-                v: 0.0,
-                position: p,
-            });
-        }
+        let pts: Vec<DVec3> = (0..200)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random::<f64>() * 0.1))
+            .collect();
+        let g = grid_of(&pts, 0.1);
         for _ in 0..500 {
             let p = DVec3::new(rng.random::<f64>() * 3.0 - 1.0, rng.random(), rng.random());
-            let brute = (0..g.samples.len() as u32)
-                .min_by(|&a, &b| {
-                    let da = g.samples[a as usize].position.distance_squared(p);
-                    let db = g.samples[b as usize].position.distance_squared(p);
-                    da.partial_cmp(&db).unwrap().then(a.cmp(&b))
-                })
-                .unwrap();
-            assert_eq!(g.nearest(p), brute);
+            assert_eq!(g.nearest(p), brute_nearest(&g, p));
         }
     }
 
+    /// A grid of radius `r` holding `points`, sample i at `points[i]`.
     fn grid_of(points: &[DVec3], r: f64) -> Grid {
         let mut g = Grid::new(DVec3::ZERO, r);
         for (i, &p) in points.iter().enumerate() {

@@ -159,12 +159,11 @@ pub(crate) fn parse(file: &str, bytes: &[u8]) -> Result<ObjMesh, SceneError> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
         ..Default::default()
     };
-    // tobj's `ignore_lines` drops two-vertex lines only: a polyline `l 1 2 3` would come
-    // back as a triangle. Point and line elements are blanked before it reads the file.
+    // Point and line elements are blanked before tobj reads the file, rather than left to
+    // its `ignore_points` / `ignore_lines`: the latter drops two-vertex lines only, so a
+    // polyline `l 1 2 3` came back as a triangle.
     let faces_only = without_points_and_lines(bytes);
     let (models, _materials) = tobj::load_obj_buf(&mut &faces_only[..], &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
