@@ -33,7 +33,7 @@ pub enum BssrdfError {
     },
     /// A preset name not in the measured table.
     UnknownPreset(String),
-    /// A model name that is not one of the models.
+    /// A model name that is not one of the models; the message lists [`crate::ModelKind::ALL`].
     UnknownModel(String),
     /// A requested diffuse reflectance the chosen model cannot produce for any albedo.
     UnreachableReflectance {
@@ -80,10 +80,15 @@ impl fmt::Display for BssrdfError {
                 f,
                 "unknown preset '{name}' (run `sss presets` for the list)"
             ),
-            BssrdfError::UnknownModel(name) => write!(
-                f,
-                "unknown model '{name}' (expected standard-dipole, better-dipole, directional-dipole or pbd)"
-            ),
+            BssrdfError::UnknownModel(name) => {
+                let names: Vec<&str> = crate::ModelKind::ALL.iter().map(|k| k.name()).collect();
+                let (last, rest) = names.split_last().expect("at least one model");
+                write!(
+                    f,
+                    "unknown model '{name}' (expected {} or {last})",
+                    rest.join(", ")
+                )
+            }
             BssrdfError::UnreachableReflectance {
                 model,
                 channel,

@@ -435,3 +435,23 @@ fn rgb_and_spatial_forms_are_the_channel_profiles() {
         }
     }
 }
+
+/// The unknown-model message lists exactly the models of `ModelKind::ALL`, in its order, so
+/// a model added to the enum cannot be missing from it.
+#[test]
+fn the_unknown_model_message_lists_every_model() {
+    let msg = "nope".parse::<ModelKind>().unwrap_err().to_string();
+    let list = msg
+        .split_once("(expected ")
+        .and_then(|(_, rest)| rest.strip_suffix(')'))
+        .unwrap_or_else(|| panic!("no list in {msg}"));
+    let (head, last) = list.rsplit_once(" or ").expect("`a, b or c`");
+    let listed: Vec<&str> = head.split(", ").chain([last]).collect();
+    let all: Vec<&str> = ModelKind::ALL.iter().map(|k| k.name()).collect();
+    assert_eq!(listed, all, "{msg}");
+    assert!(msg.contains("'nope'"), "{msg}");
+    // Every listed name parses back.
+    for name in listed {
+        assert_eq!(name.parse::<ModelKind>().unwrap().name(), name);
+    }
+}

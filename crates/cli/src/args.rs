@@ -44,6 +44,16 @@ impl MediumArgs {
     }
 }
 
+/// `what`, then the models' names from their one list ([`sss_bssrdf::ModelKind::ALL`]): the
+/// help of `--model`.
+pub fn model_help(what: &str) -> String {
+    let names: Vec<&str> = sss_bssrdf::ModelKind::ALL
+        .iter()
+        .map(|k| k.name())
+        .collect();
+    format!("{what} (one of: {})", names.join(", "))
+}
+
 /// Parses `R,G,B` (three numbers separated by commas; spaces allowed).
 pub fn parse_rgb(s: &str) -> Result<Rgb, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

@@ -79,6 +79,15 @@ fn variants(name: &str, users: &[&str]) -> Vec<(OptionSpec, Vec<&'static str>)> 
     out
 }
 
+/// An option's help text, with its accepted values ([`OptionSpec::values`]) when it lists them.
+fn help_text(spec: &OptionSpec) -> String {
+    if spec.values.is_empty() {
+        spec.help.to_string()
+    } else {
+        format!("{} (one of: {})", spec.help, spec.values.join(", "))
+    }
+}
+
 fn arg(spec: &OptionSpec, users: &[&str]) -> Arg {
     let used_by = |users: &[&str]| {
         if users.len() == METHODS.len() {
@@ -92,13 +101,13 @@ fn arg(spec: &OptionSpec, users: &[&str]) -> Arg {
     match spec.kind {
         OptionKind::Flag => {
             arg.action(ArgAction::SetTrue)
-                .help(format!("{}{}", spec.help, used_by(users)))
+                .help(format!("{}{}", help_text(spec), used_by(users)))
         }
         OptionKind::Value => {
             let help = if groups.len() <= 1 {
                 format!(
                     "{}{} [default: {}]",
-                    spec.help,
+                    help_text(spec),
                     used_by(users),
                     spec.default
                 )
@@ -106,7 +115,12 @@ fn arg(spec: &OptionSpec, users: &[&str]) -> Arg {
                 groups
                     .iter()
                     .map(|(o, ms)| {
-                        format!("{}: {} [default: {}]", ms.join(", "), o.help, o.default)
+                        format!(
+                            "{}: {} [default: {}]",
+                            ms.join(", "),
+                            help_text(o),
+                            o.default
+                        )
                     })
                     .collect::<Vec<_>>()
                     .join("; ")

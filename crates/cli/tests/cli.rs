@@ -811,6 +811,107 @@ fn kernel_bad_input_fails_with_one_line() {
     }
 }
 
+/// The names a message or a help text lists after `marker` (up to `end`), split at ", " and
+/// " or ".
+fn listed<'a>(text: &'a str, marker: &str, end: char) -> Vec<&'a str> {
+    let rest = text
+        .split_once(marker)
+        .unwrap_or_else(|| panic!("`{marker}` not in {text}"))
+        .1;
+    let list = &rest[..rest
+        .find(end)
+        .unwrap_or_else(|| panic!("no `{end}` in {rest}"))];
+    list.split(", ")
+        .flat_map(|s| s.split(" or "))
+        .map(str::trim)
+        .collect()
+}
+
+/// Lists of names in errors and help come from their one source: a model, kernel, artist
+/// preset, built-in scene or `--selection` value added there cannot be missing from them.
+#[test]
+fn errors_and_help_list_every_name_of_their_registry() {
+    let models: Vec<&str> = ModelKind::ALL.iter().map(|k| k.name()).collect();
+    for command in [
+        vec!["kernel", "--preset", "skin1", "--model", "nope"],
+        vec![
+            "filter",
+            "in.exr",
+            "--preset",
+            "skin1",
+            "--units-per-mm",
+            "1",
+            "--out",
+            "out.exr",
+            "--model",
+            "nope",
+        ],
+    ] {
+        let o = sss(&command);
+        assert_eq!(o.status.code(), Some(2), "{command:?}");
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert_eq!(listed(&err, "(expected ", ')'), models, "{err}");
+    }
+    let help = ok(&["kernel", "--help"]);
+    let flat = help.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert_eq!(
+        listed(&flat, "approximated (one of: ", ')'),
+        models,
+        "{flat}"
+    );
+
+    use sss_render::kernel_choice::KernelMethod;
+    let separable: Vec<&str> = KernelMethod::ALL
+        .iter()
+        .filter(|k| **k != KernelMethod::Exact2d)
+        .map(|k| k.name())
+        .collect();
+    let err = stderr(&sss(&[
+        "kernel", "--preset", "skin1", "--method", "exact2d",
+    ]));
+    assert_eq!(listed(&err, "choose one of ", '\n'), separable, "{err}");
+    assert_eq!(
+        listed(&flat, "The kernel (one of: ", ';'),
+        separable,
+        "{flat}"
+    );
+
+    let artist: Vec<&str> = sss_separable::artist::PRESETS
+        .iter()
+        .map(|p| p.name)
+        .collect();
+    assert_eq!(listed(&flat, "parameter set (one of: ", ')'), artist);
+    let err = stderr(&sss(&[
+        "kernel",
+        "--preset",
+        "skin1",
+        "--method",
+        "artist",
+        "--artist-preset",
+        "x",
+    ]));
+    assert_eq!(listed(&err, "(known: ", ')'), artist, "{err}");
+
+    let help = ok(&["render", "--help"]);
+    let flat = help.split_whitespace().collect::<Vec<_>>().join(" ");
+    let scenes: Vec<&str> = sss_render::scene::BUILTIN_SCENES
+        .iter()
+        .map(|(n, _)| *n)
+        .collect();
+    assert_eq!(listed(&flat, "built-in scene (", ')'), scenes, "{flat}");
+    assert_eq!(
+        listed(&flat, "screen-space convolution (one of: ", ')'),
+        KernelMethod::NAMES,
+        "{flat}"
+    );
+    assert_eq!(
+        listed(&flat, "(Max-Extent) (one of: ", ')'),
+        sss_render::integrators::manylight::SELECTIONS,
+        "{flat}"
+    );
+}
+
 /// The separable integrator on a scene: close to the exact world-space reference on a sphere
 /// (screen-space blur of the same irradiance), energy kept, silhouettes respected.
 #[test]

@@ -1,4 +1,5 @@
-//! Image output: linear OpenEXR (one layer per quantity) and tone-mapped sRGB PNG (false-colour
+//! Image output: linear OpenEXR (one part, one RGB layer per quantity: `R,G,B` for the first,
+//! `name.R,name.G,name.B` for the others) and tone-mapped sRGB PNG (false-colour
 //! error maps with a legend are drawn by `sss-plot`). Every file is written to a temporary name in the same directory
 //! and renamed into place, so a crash never leaves a half-written image.
 
@@ -23,8 +24,41 @@ fn clean(v: f64) -> f32 {
     }
 }
 
-/// Writes a linear OpenEXR file with one RGB f32 layer per `(name, pixels)` (row-major,
-/// top-left first, `width·height` pixels each).
+/// The layer name given to plain `R`, `G`, `B` channels of a part that has no `name`
+/// attribute (or an empty one), when reading ([`read_exr_within`]).
+pub const UNNAMED_LAYER: &str = "beauty";
+
+/// Why `name` cannot be a layer name of [`write_exr`], if it cannot: it must be non-empty
+/// printable ASCII without a '.' (the '.' separates layer and channel in `layer.R`, and
+/// readers split channel names at the last '.').
+fn bad_layer_name(name: &str) -> Option<&'static str> {
+    if name.is_empty() {
+        Some("is empty")
+    } else if name.contains('.') {
+        Some("contains a '.' (it separates layer and channel in `layer.R`)")
+    } else if !name.bytes().all(|b| b.is_ascii_graphic() || b == b' ') {
+        Some("is not printable ASCII")
+    } else {
+        None
+    }
+}
+
+/// Writes a linear OpenEXR file of f32 RGB layers, one `(name, pixels)` each (row-major,
+/// top-left first, `width·height` pixels each), as ONE part (one header), as Blender's
+/// multilayer EXR, Nuke and Mitsuba's AOVs do, so that readers which see only the first part
+/// (the classic `OpenEXR.InputFile`, pyexr) see every layer: the first layer (the "beauty")
+/// is the plain channels `R`, `G`, `B` and its name is the part's `name` attribute; every
+/// other layer is the channels `name.R`, `name.G`, `name.B`. [`read_exr_within`] gives the
+/// layers back by name, the beauty first.
+///
+/// Layer names must be distinct, non-empty printable ASCII without a '.': anything else is an
+/// error naming the file and the layer, and nothing is written. So is an empty `layers` or a
+/// layer not of `width·height` pixels. Non-finite and negative values are written as 0. The
+/// blocks are written in increasing order, so the same image always gives the same bytes. The
+/// file is written under a temporary name and renamed into place.
+///
+/// Versions before this layout wrote one part per layer; those files still read
+/// ([`read_exr_within`]).
 pub fn write_exr(
     path: &Path,
     width: u32,
@@ -41,31 +75,49 @@ pub fn write_exr(
             height
         )));
     }
+    for (i, (name, _)) in layers.iter().enumerate() {
+        if let Some(why) = bad_layer_name(name) {
+            return Err(crate::Error::Input(format!(
+                "{}: cannot write layer `{name}`: its name {why}; layer names must be \
+                 non-empty printable ASCII without '.'",
+                path.display()
+            )));
+        }
+        if layers[..i].iter().any(|(n, _)| n == name) {
+            return Err(crate::Error::Input(format!(
+                "{}: cannot write layer `{name}` twice; layer names must be distinct",
+                path.display()
+            )));
+        }
+    }
     let size = Vec2(w, h);
-    let layers: Vec<_> = layers
-        .iter()
-        .map(|(name, data)| {
-            let data: &[Rgb] = data;
-            Layer::new(
-                size,
-                LayerAttributes::named(*name),
-                // Blocks in increasing order: the parallel encoder otherwise writes them in the
-                // order its threads finish, so the same image would give different files.
-                Encoding {
-                    line_order: LineOrder::Increasing,
-                    ..Encoding::FAST_LOSSLESS
-                },
-                SpecificChannels::rgb(move |Vec2(x, y): Vec2<usize>| {
-                    let p = data[y * w + x];
-                    (clean(p[0]), clean(p[1]), clean(p[2]))
-                }),
-            )
-        })
-        .collect();
-    let image = Image::from_layers(
-        ImageAttributes::new(IntegerBounds::from_dimensions(size)),
-        layers,
+    let mut channels = SmallVec::<[AnyChannel<FlatSamples>; 4]>::new();
+    for (k, (name, data)) in layers.iter().enumerate() {
+        for (c, suffix) in ["R", "G", "B"].iter().enumerate() {
+            let samples: Vec<f32> = data.iter().map(|p| clean(p[c])).collect();
+            let channel = if k == 0 {
+                (*suffix).to_string()
+            } else {
+                format!("{name}.{suffix}")
+            };
+            channels.push(AnyChannel::new(
+                Text::new_or_panic(channel),
+                FlatSamples::F32(samples),
+            ));
+        }
+    }
+    let layer = Layer::new(
+        size,
+        LayerAttributes::named(Text::new_or_panic(layers[0].0)),
+        // Blocks in increasing order: the parallel encoder otherwise writes them in the order
+        // its threads finish, so the same image would give different files.
+        Encoding {
+            line_order: LineOrder::Increasing,
+            ..Encoding::FAST_LOSSLESS
+        },
+        AnyChannels::sort(channels),
     );
+    let image = Image::from_layer(layer);
     sss_util::write_atomic_with(
         path,
         |tmp| {
@@ -81,10 +133,39 @@ pub fn write_exr(
 /// Named RGB layers of an image: (layer name, pixels).
 pub type Layers = Vec<(String, Vec<Rgb>)>;
 
+/// Splits a channel name into (layer, component) at its last '.': `subsurface.R` is layer
+/// `subsurface`, component `R`; a name without '.' (`R`) has no layer. Only the components
+/// `R`, `G` and `B` are RGB channels (index 0, 1, 2); anything else is `None`.
+fn rgb_channel(name: &str) -> Option<(Option<&str>, usize)> {
+    let (layer, component) = match name.rfind('.') {
+        Some(at) => (Some(&name[..at]), &name[at + 1..]),
+        None => (None, name),
+    };
+    let c = match component {
+        "R" => 0,
+        "G" => 1,
+        "B" => 2,
+        _ => return None,
+    };
+    Some((layer, c))
+}
+
+/// How many RGB layers a part holds, as [`read_exr_within`] counts them (an upper bound):
+/// its channels named `R` or `*.R`.
+fn rgb_layer_count(header: &exr::meta::header::Header) -> u64 {
+    header
+        .channels
+        .list
+        .iter()
+        .filter(|c| matches!(rgb_channel(&c.name.to_string()), Some((_, 0))))
+        .count() as u64
+}
+
 /// The estimated bytes of reading the OpenEXR file at `path` with [`read_exr`], from its
-/// header alone (no pixel is read): per layer, width × height × (the bytes of one sample of
+/// header alone (no pixel is read): per part, width × height × (the bytes of one sample of
 /// every channel, as the `exr` crate holds them: 2 for f16, 4 for f32 and u32, subsampled
-/// channels counted at full size + 24 for the f64 RGB copy). Saturating, never overflowing.
+/// channels counted at full size + 24 for the f64 RGB copy of each RGB layer, counted as the
+/// channels named `R` or `*.R`). Saturating, never overflowing.
 pub fn exr_bytes(path: &Path) -> Result<u64, crate::Error> {
     let meta = exr::meta::MetaData::read_from_file(path, false)
         .map_err(|e| io_err(path, "reading the header of", e))?;
@@ -101,7 +182,9 @@ fn meta_bytes(meta: &exr::meta::MetaData) -> u64 {
             .iter()
             .map(|c| c.sample_type.bytes_per_sample() as u64)
             .sum::<u64>()
-            + std::mem::size_of::<Rgb>() as u64;
+            .saturating_add(
+                rgb_layer_count(header).saturating_mul(std::mem::size_of::<Rgb>() as u64),
+            );
         total = total.saturating_add(pixels.saturating_mul(per_pixel));
     }
     total
@@ -121,8 +204,9 @@ pub fn check_exr_budget(paths: &[&Path], budget: u64) -> Result<(), crate::Error
             .iter()
             .map(|h| format!("{}x{}", h.layer_size.0, h.layer_size.1))
             .collect();
+        let layers: u64 = meta.headers.iter().map(rgb_layer_count).sum();
         what.push(format!(
-            "{} ({} layer(s) of {})",
+            "{} ({layers} layer(s) in {} part(s) of {})",
             path.display(),
             sizes.len(),
             sizes.join(", ")
@@ -146,8 +230,20 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Layers), crate::Error> {
     read_exr_within(path, crate::budget::default_budget())
 }
 
-/// Reads every RGB layer of an OpenEXR file, with the image size (width, height). The RGB
-/// layers must all have that one size (an error names the file and the layers otherwise).
+/// Reads every RGB layer of an OpenEXR file, with the image size (width, height).
+///
+/// Both layouts read: one part holding every layer (as [`write_exr`] writes, and Blender,
+/// Nuke and Mitsuba), and one part per layer (as versions before it wrote). In every part,
+/// each channel name is split at its last '.': the prefix is the layer name and the suffix
+/// must be `R`, `G` or `B` (other channels, such as `A` or `Z`, are ignored); plain `R`, `G`,
+/// `B` belong to the layer named by the part's `name` attribute, or [`UNNAMED_LAYER`]
+/// (`beauty`) when the part has no name (or an empty one). A layer is read when it has all
+/// three of `R`, `G` and `B`. The layers come in file order, part by part, each part's plain
+/// layer first, then its prefixed layers in channel order (alphabetical, as EXR stores
+/// channels). A name found twice gives two layers; callers that look layers up by name take
+/// the first.
+///
+/// The RGB layers must all have one size (an error names the file and the layers otherwise).
 /// A file whose header says it needs more than `budget` bytes is refused before any pixel is
 /// read ([`check_exr_budget`]).
 pub fn read_exr_within(path: &Path, budget: u64) -> Result<(u32, u32, Layers), crate::Error> {
@@ -163,29 +259,38 @@ pub fn read_exr_within(path: &Path, budget: u64) -> Result<(u32, u32, Layers), c
         .map_err(|e| io_err(path, "reading", e))?;
     let mut out: self::Layers = Vec::new();
     let mut size = (0, 0);
-    for layer in &image.layer_data {
-        let (w, h) = (layer.size.0, layer.size.1);
-        let mut px = vec![[0.0f64; 3]; w * h];
-        let mut found = 0;
-        for ch in &layer.channel_data.list {
-            let c = match ch.name.to_string().as_str() {
-                "R" => 0,
-                "G" => 1,
-                "B" => 2,
-                _ => continue,
+    for part in &image.layer_data {
+        let (w, h) = (part.size.0, part.size.1);
+        let plain = part
+            .attributes
+            .layer_name
+            .as_ref()
+            .map(|n| n.to_string())
+            .filter(|n| !n.is_empty())
+            .unwrap_or_else(|| UNNAMED_LAYER.to_string());
+        // (layer name, channel index of R, G, B in this part), the plain layer first.
+        let mut found: Vec<(String, [Option<usize>; 3])> = vec![(plain, [None; 3])];
+        for (k, ch) in part.channel_data.list.iter().enumerate() {
+            let name = ch.name.to_string();
+            let Some((layer, c)) = rgb_channel(&name) else {
+                continue;
             };
-            found += 1;
-            for (i, v) in ch.sample_data.values_as_f32().enumerate().take(w * h) {
-                px[i][c] = if v.is_finite() { v as f64 } else { 0.0 };
-            }
+            let slot = match layer {
+                None => 0,
+                Some(layer) => match found.iter().skip(1).position(|(n, _)| n == layer) {
+                    Some(i) => i + 1,
+                    None => {
+                        found.push((layer.to_string(), [None; 3]));
+                        found.len() - 1
+                    }
+                },
+            };
+            found[slot].1[c] = Some(k);
         }
-        if found == 3 {
-            let name = layer
-                .attributes
-                .layer_name
-                .as_ref()
-                .map(|n| n.to_string())
-                .unwrap_or_default();
+        for (name, rgb) in found {
+            let [Some(r), Some(g), Some(b)] = rgb else {
+                continue;
+            };
             let this = (w as u32, h as u32);
             if let Some((first, _)) = out.first()
                 && this != size
@@ -201,6 +306,13 @@ pub fn read_exr_within(path: &Path, budget: u64) -> Result<(u32, u32, Layers), c
                 )));
             }
             size = this;
+            let mut px = vec![[0.0f64; 3]; w * h];
+            for (c, k) in [r, g, b].into_iter().enumerate() {
+                let samples = part.channel_data.list[k].sample_data.values_as_f32();
+                for (i, v) in samples.enumerate().take(w * h) {
+                    px[i][c] = if v.is_finite() { v as f64 } else { 0.0 };
+                }
+            }
             out.push((name, px));
         }
     }

@@ -53,8 +53,34 @@ impl KernelMethod {
         KernelMethod::Exact2d,
     ];
 
+    /// The command-line names of [`KernelMethod::ALL`], in its order.
+    pub const NAMES: [&'static str; 9] = {
+        let mut names = [""; 9];
+        let mut i = 0;
+        while i < names.len() {
+            names[i] = KernelMethod::ALL[i].name();
+            i += 1;
+        }
+        names
+    };
+
+    /// The names of the separable kernels: [`KernelMethod::NAMES`] but `exact2d` (which
+    /// `sss kernel` cannot export).
+    pub fn separable_names() -> Vec<&'static str> {
+        KernelMethod::ALL
+            .iter()
+            .filter(|k| k.is_separable())
+            .map(|k| k.name())
+            .collect()
+    }
+
+    /// Whether this is a separable kernel (every method but [`KernelMethod::Exact2d`]).
+    pub const fn is_separable(self) -> bool {
+        !matches!(self, KernelMethod::Exact2d)
+    }
+
     /// The command-line name.
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             KernelMethod::Preintegrated => "preintegrated",
             KernelMethod::Svd1 => "svd1",
@@ -83,8 +109,10 @@ impl FromStr for KernelMethod {
             .copied()
             .find(|k| k.name() == s)
             .ok_or_else(|| {
-                let names: Vec<&str> = KernelMethod::ALL.iter().map(|k| k.name()).collect();
-                format!("unknown kernel `{s}` (known: {})", names.join(", "))
+                format!(
+                    "unknown kernel `{s}` (known: {})",
+                    KernelMethod::NAMES.join(", ")
+                )
             })
     }
 }

@@ -1,7 +1,12 @@
-//! EXR sizes read from a file are checked against the memory budget before any pixel is read.
+//! EXR sizes read from a file are checked against the memory budget before any pixel is read;
+//! the layout `write_exr` writes (one part: `R,G,B` for the first layer, `name.R,name.G,name.B`
+//! for the others) and the layouts `read_exr` reads (that one, and one part per layer).
 
-use sss_render::image::{check_exr_budget, exr_bytes, read_exr, read_exr_within, write_exr};
-use std::path::PathBuf;
+use sss_bssrdf::Rgb;
+use sss_render::image::{
+    UNNAMED_LAYER, check_exr_budget, exr_bytes, read_exr, read_exr_within, write_exr,
+};
+use std::path::{Path, PathBuf};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("sss-exr-budget-{}-{name}", std::process::id()));
@@ -79,5 +84,254 @@ fn a_header_claiming_a_huge_data_window_is_refused_before_reading_pixels() {
         e.contains("40000x40000") && e.contains("57600000000 bytes"),
         "{e}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `n` pixels whose values differ per pixel, channel and `layer`, exactly representable in f32.
+fn ramp(n: usize, layer: usize) -> Vec<Rgb> {
+    (0..n)
+        .map(|i| {
+            let base = (100 * layer + i) as f64;
+            [base + 0.25, base + 0.5, base + 0.75]
+        })
+        .collect()
+}
+
+#[test]
+fn three_layers_round_trip_by_name_with_the_first_layer_first() {
+    let dir = temp_dir("round-trip");
+    let path = dir.join("three.exr");
+    let (total, sub, err) = (ramp(12, 1), ramp(12, 2), ramp(12, 3));
+    // Bad values are written as 0.
+    let mut dirty = err.clone();
+    dirty[5] = [f64::NAN, -1.0, f64::INFINITY];
+    write_exr(
+        &path,
+        4,
+        3,
+        &[
+            ("total", &total),
+            ("subsurface", &sub),
+            ("std_error", &dirty),
+        ],
+    )
+    .unwrap();
+    let (w, h, layers) = read_exr(&path).unwrap();
+    assert_eq!((w, h), (4, 3));
+    let names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
+    // The first layer is the plain R, G, B; the others follow in channel (alphabetical) order.
+    assert_eq!(names, ["total", "std_error", "subsurface"]);
+    let mut clean = err.clone();
+    clean[5] = [0.0; 3];
+    assert_eq!(layers[0].1, total);
+    assert_eq!(layers[1].1, clean);
+    assert_eq!(layers[2].1, sub);
+    // The same image gives the same bytes.
+    let again = dir.join("again.exr");
+    write_exr(
+        &again,
+        4,
+        3,
+        &[
+            ("total", &total),
+            ("subsurface", &sub),
+            ("std_error", &dirty),
+        ],
+    )
+    .unwrap();
+    assert_eq!(
+        std::fs::read(&path).unwrap(),
+        std::fs::read(&again).unwrap()
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_written_file_is_one_part_with_layer_prefixed_channels() {
+    let dir = temp_dir("one-part");
+    let path = dir.join("one.exr");
+    let px = ramp(6, 0);
+    write_exr(
+        &path,
+        3,
+        2,
+        &[("total", &px), ("subsurface", &px), ("std_error", &px)],
+    )
+    .unwrap();
+    let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+    assert_eq!(meta.headers.len(), 1, "one part, not one per layer");
+    let header = &meta.headers[0];
+    let channels: Vec<String> = header
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    assert_eq!(
+        channels,
+        [
+            "B",
+            "G",
+            "R",
+            "std_error.B",
+            "std_error.G",
+            "std_error.R",
+            "subsurface.B",
+            "subsurface.G",
+            "subsurface.R"
+        ]
+    );
+    assert!(
+        header
+            .channels
+            .list
+            .iter()
+            .all(|c| c.sample_type == exr::meta::attribute::SampleType::F32)
+    );
+    assert_eq!(
+        header
+            .own_attributes
+            .layer_name
+            .as_ref()
+            .map(|n| n.to_string()),
+        Some("total".to_string())
+    );
+    assert_eq!(
+        (header.layer_size.0, header.layer_size.1),
+        (3, 2),
+        "image size"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn layer_names_that_cannot_round_trip_are_refused_and_nothing_is_written() {
+    let dir = temp_dir("names");
+    let path = dir.join("bad.exr");
+    let px = ramp(4, 0);
+    for (layers, why) in [
+        (vec![("total", &px[..]), ("sub.surface", &px[..])], "'.'"),
+        (vec![("to.tal", &px[..])], "'.'"),
+        (vec![("total", &px[..]), ("", &px[..])], "empty"),
+        (vec![("total", &px[..]), ("tötal", &px[..])], "ASCII"),
+        (vec![("total", &px[..]), ("total", &px[..])], "twice"),
+    ] {
+        let e = write_exr(&path, 2, 2, &layers).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, sss_render::Error::Input(_)), "{e:?}");
+        assert!(msg.contains("bad.exr") && msg.contains(why), "{msg}");
+        assert!(!path.exists(), "{layers:?} wrote a file");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// One part of a hand-built EXR: its name, if any, and its channels `(name, value)`.
+type Part<'a> = (Option<&'a str>, &'a [(&'a str, f32)]);
+
+/// Writes one part per `(part name, channels)`, each channel `(name, value)` of `w`x`h` f32
+/// samples, as files of earlier versions and other tools are laid out.
+fn write_parts(path: &Path, w: usize, h: usize, parts: &[Part]) {
+    use exr::prelude::*;
+    let layers: Vec<_> = parts
+        .iter()
+        .map(|(name, channels)| {
+            let list = channels
+                .iter()
+                .map(|&(c, v)| AnyChannel::new(c, FlatSamples::F32(vec![v; w * h])))
+                .collect();
+            let attributes = match name {
+                Some(n) => LayerAttributes::named(*n),
+                None => LayerAttributes::default(),
+            };
+            Layer::new(
+                Vec2(w, h),
+                attributes,
+                Encoding::UNCOMPRESSED,
+                AnyChannels::sort(list),
+            )
+        })
+        .collect();
+    Image::from_layers(
+        ImageAttributes::new(IntegerBounds::from_dimensions(Vec2(w, h))),
+        layers,
+    )
+    .write()
+    .to_file(path)
+    .expect("write the test EXR");
+}
+
+#[test]
+fn multi_part_files_of_earlier_versions_still_read_by_part_name() {
+    let dir = temp_dir("multi-part");
+    let path = dir.join("old.exr");
+    write_parts(
+        &path,
+        3,
+        2,
+        &[
+            (Some("total"), &[("R", 1.0), ("G", 2.0), ("B", 3.0)]),
+            (Some("subsurface"), &[("R", 4.0), ("G", 5.0), ("B", 6.0)]),
+            (
+                Some("std_error"),
+                &[("R", 7.0), ("G", 8.0), ("B", 9.0), ("A", 1.0)],
+            ),
+        ],
+    );
+    assert_eq!(
+        exr::meta::MetaData::read_from_file(&path, false)
+            .unwrap()
+            .headers
+            .len(),
+        3
+    );
+    let (w, h, layers) = read_exr(&path).unwrap();
+    assert_eq!((w, h), (3, 2));
+    let names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["total", "subsurface", "std_error"]);
+    for (k, (_, px)) in layers.iter().enumerate() {
+        let v = 3.0 * k as f64;
+        assert!(
+            px.iter().all(|p| *p == [v + 1.0, v + 2.0, v + 3.0]),
+            "{px:?}"
+        );
+    }
+    // 3 parts × 6 px × (3 or 4 f32 channels + one f64 RGB copy).
+    assert_eq!(exr_bytes(&path).unwrap(), 6 * (2 * (12 + 24) + (16 + 24)));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn plain_channels_of_an_unnamed_part_and_dotted_prefixes_read() {
+    let dir = temp_dir("unnamed");
+    let path = dir.join("blender.exr");
+    // As Blender names its passes: view layer, pass, component; the last '.' splits.
+    write_parts(
+        &path,
+        2,
+        2,
+        &[(
+            None,
+            &[
+                ("R", 1.0),
+                ("G", 2.0),
+                ("B", 3.0),
+                ("A", 1.0),
+                ("ViewLayer.Combined.R", 4.0),
+                ("ViewLayer.Combined.G", 5.0),
+                ("ViewLayer.Combined.B", 6.0),
+                ("ViewLayer.Combined.A", 1.0),
+                ("ViewLayer.Depth.Z", 9.0),
+                // Not a whole RGB layer: ignored.
+                ("half.R", 9.0),
+                ("half.G", 9.0),
+            ],
+        )],
+    );
+    let (w, h, layers) = read_exr(&path).unwrap();
+    assert_eq!((w, h), (2, 2));
+    let names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, [UNNAMED_LAYER, "ViewLayer.Combined"]);
+    assert_eq!(layers[0].1, vec![[1.0, 2.0, 3.0]; 4]);
+    assert_eq!(layers[1].1, vec![[4.0, 5.0, 6.0]; 4]);
     let _ = std::fs::remove_dir_all(&dir);
 }

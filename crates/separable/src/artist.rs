@@ -71,8 +71,8 @@ pub const PRESETS: [ArtistPreset; 2] = [
     },
 ];
 
-/// A Table 2 preset by name (`close-fit` or `production`, case-insensitive, `_`/space as
-/// `-`).
+/// A Table 2 preset by name (one of [`PRESETS`]: `close-fit` or `production`,
+/// case-insensitive, `_`/space as `-`); the error lists the names of [`PRESETS`].
 pub fn preset(name: &str) -> Result<ArtistParams, SeparableError> {
     let key: String = name
         .trim()
@@ -85,8 +85,10 @@ pub fn preset(name: &str) -> Result<ArtistParams, SeparableError> {
         .find(|p| p.name == key)
         .map(|p| p.params)
         .ok_or_else(|| {
+            let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
             SeparableError::InvalidArgument(format!(
-                "unknown artist preset `{name}` (close-fit, production)"
+                "unknown artist preset `{name}` (known: {})",
+                names.join(", ")
             ))
         })
 }

@@ -28,8 +28,8 @@ pub struct FilterArgs {
     /// Scene units per millimetre of the input's depth and footprint.
     #[arg(long)]
     pub units_per_mm: f64,
-    /// The BSSRDF model whose R_d the kernel approximates.
-    #[arg(long, default_value = "better-dipole")]
+    /// The BSSRDF model whose R_d the kernel approximates (the help lists `ModelKind::ALL`).
+    #[arg(long, default_value = "better-dipole", help = crate::args::model_help("The BSSRDF model whose R_d the kernel approximates"))]
     pub model: ModelKind,
     /// The kernel and filter options.
     #[command(flatten)]

@@ -15,7 +15,7 @@
 //! WGSL cannot query. `crates/separable/examples/separable_sss.wgsl` is a two-pass compute
 //! shader that applies a pasted WGSL export with the CPU filter's silhouette rules.
 
-use crate::args::MediumArgs;
+use crate::args::{MediumArgs, model_help};
 use crate::profile_table::{MediumSpec, build_medium};
 use clap::{Args, ValueEnum};
 use sss_bssrdf::{ModelKind, Rgb, make_model};
@@ -48,16 +48,22 @@ pub struct KernelArgs {
     /// The medium.
     #[command(flatten)]
     pub medium: MediumArgs,
-    /// The BSSRDF model whose R_d is approximated.
-    #[arg(long, default_value = "better-dipole")]
+    /// The BSSRDF model whose R_d is approximated (the help lists `ModelKind::ALL`).
+    #[arg(long, default_value = "better-dipole", help = model_help("The BSSRDF model whose R_d is approximated"))]
     pub model: ModelKind,
-    /// The kernel: preintegrated, svd1, svd3, svd6, artist (fitted to the material), guided,
-    /// gaussians1, gaussians6.
-    #[arg(long, default_value = "preintegrated")]
+    /// The kernel (the help lists the separable ones of `KernelMethod::ALL`; `artist` is
+    /// fitted to the material).
+    #[arg(long, default_value = "preintegrated", help = format!(
+        "The kernel (one of: {}; artist is fitted to the material)",
+        KernelMethod::separable_names().join(", ")
+    ))]
     pub method: KernelMethod,
-    /// With `--method artist`: use a Table 2 parameter set (`close-fit` or `production`)
-    /// instead of fitting the material.
-    #[arg(long)]
+    /// With `--method artist`: use a Table 2 parameter set (the help lists
+    /// `sss_separable::artist::PRESETS`) instead of fitting the material.
+    #[arg(long, help = format!(
+        "With --method artist: use a Table 2 parameter set (one of: {}) instead of fitting the material",
+        artist::PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+    ))]
     pub artist_preset: Option<String>,
     /// Guided-optimisation exponent k in [0, 4].
     #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
@@ -68,8 +74,8 @@ pub struct KernelArgs {
     /// Place taps uniformly instead of by importance (SVD terms always are).
     #[arg(long)]
     pub uniform: bool,
-    /// Output format: json, csv, or shader constants (glsl, hlsl, wgsl) in the
-    /// float4(r, g, b, offset_mm) layout, centre tap first.
+    /// Output format; shader constants are in the float4(r, g, b, offset_mm) layout, centre
+    /// tap first.
     #[arg(long, value_enum, default_value_t = KernelFormat::Json)]
     pub format: KernelFormat,
     /// Scale the weights to sum to 1 instead of the total diffuse reflectance.
@@ -105,10 +111,12 @@ fn taps_json(k: &Kernel1d) -> String {
 /// Runs `sss kernel`: the kernel text for stdout.
 pub fn run(args: &KernelArgs) -> Result<String, Error> {
     check_separable_options(args.taps, args.k, 0.0)?;
-    if args.method == KernelMethod::Exact2d {
-        return Err(Error::Input(
-            "--method exact2d is the full 2D kernel, not a separable one; choose preintegrated, svd1, svd3, svd6, artist, guided, gaussians1 or gaussians6".into(),
-        ));
+    if !args.method.is_separable() {
+        return Err(Error::Input(format!(
+            "--method {} is the full 2D kernel, not a separable one; choose one of {}",
+            args.method,
+            KernelMethod::separable_names().join(", ")
+        )));
     }
     if args.artist_preset.is_some() && args.method != KernelMethod::Artist {
         return Err(Error::Input("--artist-preset needs --method artist".into()));

@@ -16,8 +16,12 @@ use std::path::{Path, PathBuf};
 /// Arguments of `sss render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// A scene file (TOML), or the name of a built-in scene (sphere, toad, picnic, backlit,
-    /// slab, bunny).
+    /// A scene file (TOML), or the name of a built-in scene (the help lists
+    /// `sss_render::scene::BUILTIN_SCENES`).
+    #[arg(help = format!(
+        "A scene file (TOML), or the name of a built-in scene ({})",
+        scene::BUILTIN_SCENES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+    ))]
     pub scene: String,
     /// The integrator.
     #[arg(long, default_value = "exact", value_parser = method_parser())]
@@ -39,16 +43,16 @@ pub struct RenderArgs {
     /// Directory to search for meshes (repeatable; SSS_MESH_DIR is searched too).
     #[arg(long, value_name = "DIR")]
     pub mesh_dir: Vec<PathBuf>,
-    /// Linear OpenEXR output (layers `total`, `subsurface`, and `std_error` for stochastic
-    /// methods).
+    /// Linear OpenEXR output, one part: layer `total` as the channels R,G,B, then
+    /// `subsurface.R,G,B` and, for stochastic methods, `std_error.R,G,B`.
     #[arg(long, value_name = "FILE.exr")]
     pub out: Option<PathBuf>,
     /// Tone-mapped sRGB PNG of the total.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
-    /// Also write the method's screen-space inputs (separable: layers `irradiance`, and
-    /// `surface` = depth, footprint in scene units and object id + 1, 0 for none) for
-    /// `sss filter`.
+    /// Also write the method's screen-space inputs (separable: layer `irradiance` as R,G,B,
+    /// and `surface.R,G,B` = depth, footprint in scene units and object id + 1, 0 for none)
+    /// for `sss filter`.
     #[arg(long, value_name = "FILE.exr")]
     pub gbuffer: Option<PathBuf>,
 }

@@ -75,6 +75,7 @@ pub const IRRADIANCE_POINTS: OptionSpec = OptionSpec {
     default: "4096",
     help: "Irradiance points drawn per shading point before the pixel is estimated (the paper uses 4096)",
     kind: OptionKind::Value,
+    values: &[],
 };
 
 /// `--uniform-points` (shared by `mdlc` and `eelc`).
@@ -84,6 +85,7 @@ pub const UNIFORM_POINTS: OptionSpec = OptionSpec {
     default: "",
     help: "Draw the irradiance points uniformly by area over the object instead of by BSSRDF importance sampling (probe rays)",
     kind: OptionKind::Flag,
+    values: &[],
 };
 
 /// `--max-pairs N` (shared by `mdlc` and `eelc`).
@@ -93,6 +95,7 @@ pub const MAX_PAIRS: OptionSpec = OptionSpec {
     default: "200000",
     help: "Cap on the cluster pairs (gather cluster x light cluster) of one pixel and object (pixels at the cap are counted and warned about)",
     kind: OptionKind::Value,
+    values: &[],
 };
 
 /// The most irradiance points per shading point (`--irradiance-points`).

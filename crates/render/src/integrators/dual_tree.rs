@@ -69,6 +69,7 @@ pub const OPTIONS: [OptionSpec; 4] = [
         help: "ρ of Eq. 6: a cluster of pixels is shaded as one when its extent is below \
                ρ / max s_p pixels (0 shades every pixel; the paper uses 0.75)",
         kind: OptionKind::Value,
+        values: &[],
     },
 ];
 

@@ -33,6 +33,7 @@ pub const SAMPLE_OPTIONS: [OptionSpec; 2] = [
         default: "0.5",
         help: "Irradiance sample spacing in units of the smallest reduced mean free path",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "max-samples",
@@ -40,6 +41,7 @@ pub const SAMPLE_OPTIONS: [OptionSpec; 2] = [
         default: "100000",
         help: "At most this many irradiance samples per object (the spacing grows to respect it)",
         kind: OptionKind::Value,
+        values: &[],
     },
 ];
 

@@ -63,6 +63,7 @@ pub const OPTIONS: [OptionSpec; 7] = [
         default: "0.02",
         help: "Relative error threshold: refine each pixel until its Student-t interval is below E times its value (the paper uses 0.02)",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "alpha",
@@ -70,13 +71,15 @@ pub const OPTIONS: [OptionSpec; 7] = [
         default: "0.95",
         help: "Confidence level of the interval, in (0, 1)",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "selection",
-        value_name: "bssrdf|max-extent",
+        value_name: "SELECTION",
         default: "bssrdf",
         help: "Cluster to refine: BSSRDF-aware (Nabata & Iwasaki Eq. 10-13) or the largest box (Max-Extent)",
         kind: OptionKind::Value,
+        values: &SELECTIONS,
     },
     OptionSpec {
         name: "vpls",
@@ -84,6 +87,7 @@ pub const OPTIONS: [OptionSpec; 7] = [
         default: "1024",
         help: "VPLs per quad or environment light (a point or directional light is one VPL)",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "max-triplets",
@@ -91,6 +95,7 @@ pub const OPTIONS: [OptionSpec; 7] = [
         default: "200000",
         help: "Cap on the triplets of one pixel and object (pixels at the cap are counted and warned about)",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "bounce-vpls",
@@ -98,6 +103,7 @@ pub const OPTIONS: [OptionSpec; 7] = [
         default: "0",
         help: "Light paths traced for one indirect bounce off opaque diffuse surfaces, each leaving a VPL where it lands (0: direct light only, comparable with exact and pathtrace)",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "max-splits",
@@ -105,6 +111,7 @@ pub const OPTIONS: [OptionSpec; 7] = [
         default: "200000",
         help: "Cap on the triangle splits of one pixel and object, about 400 bytes each, allocated as needed (pixels at the cap are counted and warned about)",
         kind: OptionKind::Value,
+        values: &[],
     },
 ];
 
@@ -184,13 +191,18 @@ pub(crate) fn alpha_option(o: &MethodOptions, options: &[OptionSpec]) -> Result<
     Ok(alpha)
 }
 
-/// Parses `--selection`.
+/// The values of `--selection`, as the help and the error list them: `bssrdf` (also spelt
+/// `bssrdf-aware`) and `max-extent`.
+pub const SELECTIONS: [&str; 2] = ["bssrdf", "max-extent"];
+
+/// Parses `--selection` (one of [`SELECTIONS`]; the error lists them).
 pub fn parse_selection(s: &str) -> Result<Selection, Error> {
     match s.trim() {
         "bssrdf" | "bssrdf-aware" => Ok(Selection::BssrdfAware),
         "max-extent" => Ok(Selection::MaxExtent),
         other => Err(Error::Input(format!(
-            "--selection: unknown value `{other}` (known: bssrdf, max-extent)"
+            "--selection: unknown value `{other}` (known: {})",
+            SELECTIONS.join(", ")
         ))),
     }
 }

@@ -32,6 +32,7 @@ pub const OPTIONS: [OptionSpec; 5] = [
         default: "0.02",
         help: "Lightcuts' relative threshold: refine the cut until every cluster pair's error bound is below E times the pixel's estimate (Weber's law; the paper uses 0.02)",
         kind: OptionKind::Value,
+        values: &[],
     },
     IRRADIANCE_POINTS,
     UNIFORM_POINTS,

@@ -30,6 +30,10 @@ pub struct OptionSpec {
     pub help: &'static str,
     /// Value or switch.
     pub kind: OptionKind,
+    /// The accepted values, from their one source (a registry's names), listed in the help;
+    /// empty when any value of the option's type is accepted. The method still checks the
+    /// value when it parses it.
+    pub values: &'static [&'static str],
 }
 
 /// Option values given by a caller, by option name; options not given take their defaults.
@@ -121,6 +125,7 @@ mod tests {
             default: "16",
             help: "",
             kind: OptionKind::Value,
+            values: &[],
         },
         OptionSpec {
             name: "fast",
@@ -128,6 +133,7 @@ mod tests {
             default: "",
             help: "",
             kind: OptionKind::Flag,
+            values: &[],
         },
     ];
 

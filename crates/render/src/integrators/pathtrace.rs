@@ -364,6 +364,7 @@ const OPTIONS: [OptionSpec; 2] = [
         default: "16",
         help: "BSSRDF samples per pixel sample",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "probe-energy",
@@ -372,6 +373,7 @@ const OPTIONS: [OptionSpec; 2] = [
         help: "Fraction of each channel's profile energy inside its probe sphere, in (0, 1); the \
                energy beyond the largest sphere is never sampled (stat probe_missed_energy)",
         kind: OptionKind::Value,
+        values: &[],
     },
 ];
 

@@ -33,9 +33,9 @@ pub const OPTIONS: [OptionSpec; 5] = [
         name: "kernel",
         value_name: "KERNEL",
         default: "preintegrated",
-        help: "Separable kernel: preintegrated, svd1, svd3, svd6, artist, guided, gaussians1, \
-               gaussians6, or exact2d for the brute-force 2D screen-space convolution",
+        help: "Separable kernel, or exact2d for the brute-force 2D screen-space convolution",
         kind: OptionKind::Value,
+        values: &KernelMethod::NAMES,
     },
     OptionSpec {
         name: "taps",
@@ -43,6 +43,7 @@ pub const OPTIONS: [OptionSpec; 5] = [
         default: "7",
         help: "taps per 1D pass",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "uniform-taps",
@@ -50,6 +51,7 @@ pub const OPTIONS: [OptionSpec; 5] = [
         default: "",
         help: "place taps uniformly instead of by importance",
         kind: OptionKind::Flag,
+        values: &[],
     },
     OptionSpec {
         name: "k",
@@ -57,6 +59,7 @@ pub const OPTIONS: [OptionSpec; 5] = [
         default: "2",
         help: "guided-optimisation exponent k in [0, 4]",
         kind: OptionKind::Value,
+        values: &[],
     },
     OptionSpec {
         name: "jitter",
@@ -65,6 +68,7 @@ pub const OPTIONS: [OptionSpec; 5] = [
         help: "fraction of the kernel support within which the filter axes are \
                rotated per pixel (0 turns the jitter off)",
         kind: OptionKind::Value,
+        values: &[],
     },
 ];
 

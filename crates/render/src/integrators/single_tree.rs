@@ -46,6 +46,7 @@ pub const OPTIONS: [OptionSpec; 3] = [
         help: "Solid-angle threshold ε: a node of irradiance samples stands for all of them \
                when A / d² < ε (smaller is more accurate and slower)",
         kind: OptionKind::Value,
+        values: &[],
     },
 ];
 
