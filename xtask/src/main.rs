@@ -141,6 +141,22 @@ struct CompareArgs {
     /// (with --trees, both).
     #[arg(long)]
     manylight: bool,
+    /// Run only the I-th of N balanced shares of the default experiments (e.g. 2/8) into
+    /// --out, for a cluster's array job; join the shares with --merge. Shards share the
+    /// references through --cache (fill it first with --prepare).
+    #[arg(long, value_name = "I/N")]
+    shard: Option<compare::Shard>,
+    /// Join the directories of finished --shard runs into --out: the results.csv, plots and
+    /// report.md of an unsharded run (refused if the shards' settings or versions differ).
+    #[arg(long, value_name = "DIR", num_args = 1.., conflicts_with_all = ["shard", "prepare"])]
+    merge: Vec<PathBuf>,
+    /// Only compute every reference (Monte Carlo profiles, each scene's exact render) into the
+    /// cache: the first job of a sharded run.
+    #[arg(long, conflicts_with = "shard")]
+    prepare: bool,
+    /// The reference cache [default: OUT/cache]; give shards one on a shared filesystem.
+    #[arg(long, value_name = "DIR")]
+    cache: Option<PathBuf>,
 }
 
 fn workspace_root() -> PathBuf {
@@ -198,10 +214,12 @@ fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
-            let _ = e.print();
+            // Help and version go to stdout as clap writes them; a usage error is one line.
             return if e.use_stderr() {
+                eprintln!("{}", sss_cli::one_line(&e.to_string()));
                 ExitCode::from(2)
             } else {
+                let _ = e.print();
                 ExitCode::SUCCESS
             };
         }
@@ -285,6 +303,10 @@ fn main() -> ExitCode {
                 quick: args.quick,
                 trees: args.trees,
                 manylight: args.manylight,
+                shard: args.shard,
+                merge: args.merge,
+                prepare: args.prepare,
+                cache: args.cache,
             };
             compare::run(&config)
         }
@@ -295,5 +317,37 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bad `--shard` is one line naming the value and the rule; `--merge` and `--shard`
+    /// do not go together.
+    #[test]
+    fn bad_shard_is_one_line() {
+        for (value, why) in [
+            ("0/0", "N must be at least 1"),
+            ("3/2", "I must lie in 1..=N"),
+            ("two/3", "I is not a number"),
+        ] {
+            let e = Cli::try_parse_from(["cargo xtask", "compare", "--shard", value]).unwrap_err();
+            assert!(e.use_stderr());
+            let line = sss_cli::one_line(&e.to_string());
+            assert!(!line.contains('\n'), "{line}");
+            assert!(line.starts_with("error: "), "{line}");
+            assert!(line.contains(value) && line.contains(why), "{line}");
+        }
+        let ok = Cli::try_parse_from(["cargo xtask", "compare", "--shard", "2/3"]).unwrap();
+        let Task::Compare(args) = ok.task else {
+            panic!("not compare");
+        };
+        assert_eq!(args.shard, Some(compare::Shard { index: 2, count: 3 }));
+        assert!(
+            Cli::try_parse_from(["cargo xtask", "compare", "--shard", "1/2", "--merge", "a"])
+                .is_err()
+        );
     }
 }

@@ -154,8 +154,9 @@ pub fn run(cli: &Cli, out: &mut dyn Write) -> Result<(), Error> {
         })
 }
 
-/// Joins a multi-line clap message into one line, dropping the usage and help hints.
-fn one_line(message: &str) -> String {
+/// Joins a multi-line clap message into one line, dropping the usage and help hints (also
+/// used by `xtask`).
+pub fn one_line(message: &str) -> String {
     let parts: Vec<&str> = message
         .lines()
         .map(str::trim)

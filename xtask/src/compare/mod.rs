@@ -9,8 +9,13 @@
 //!
 //! Everything random is seeded ([`Config::seed`]), so error figures are reproducible; only
 //! the timings vary from run to run.
+//!
+//! The default experiments can be split over many machines ([`shard`]): `--prepare` fills the
+//! reference cache, `--shard I/N` runs a share of the work, `--merge` joins the shares into
+//! the same `results.csv`, plots and report.
 
 mod checked;
+mod host;
 mod kernels;
 mod manylight;
 mod metrics;
@@ -18,10 +23,12 @@ mod output;
 mod profiles;
 mod reference;
 mod scenes;
+mod shard;
 mod subset;
 mod trees;
 
 pub use scenes::default_mesh_dirs;
+pub use shard::Shard;
 
 use output::write_atomic;
 use reference::PresetReference;
@@ -67,12 +74,47 @@ pub struct Config {
     pub trees: bool,
     /// Run only the paper-scale many-light experiments ([`manylight`]).
     pub manylight: bool,
+    /// Run only this share of the default experiments ([`shard`]).
+    pub shard: Option<Shard>,
+    /// Join these shard directories into `out` instead of running anything ([`shard`]).
+    pub merge: Vec<PathBuf>,
+    /// Only compute the references into the cache ([`shard`]'s first job).
+    pub prepare: bool,
+    /// The cache directory [default: `out/cache`].
+    pub cache: Option<PathBuf>,
 }
 
 impl Config {
+    /// The default experiments of `presets` and `scenes` into `out`, with the defaults of
+    /// `cargo xtask compare` for the rest (full run, seed 1, no cache elsewhere, no sharding).
+    pub fn new(presets: Vec<String>, scenes: Vec<String>, out: PathBuf) -> Config {
+        Config {
+            presets,
+            photons: DEFAULT_PHOTONS,
+            seed: 1,
+            bins: 100,
+            out,
+            fresh: false,
+            scenes,
+            mesh_dirs: Vec::new(),
+            quick: false,
+            trees: false,
+            manylight: false,
+            shard: None,
+            merge: Vec::new(),
+            prepare: false,
+            cache: None,
+        }
+    }
+
     /// True when only paper-scale experiments run (they use no Monte Carlo reference).
     pub fn paper_only(&self) -> bool {
         self.trees || self.manylight
+    }
+
+    /// Where references are cached: `--cache`, or `cache/` in the output directory.
+    pub fn cache_dir(&self) -> PathBuf {
+        self.cache.clone().unwrap_or_else(|| self.out.join("cache"))
     }
 }
 
@@ -160,9 +202,28 @@ fn check(config: &Config) -> Result<Vec<&'static Preset>, Error> {
     Ok(out)
 }
 
-/// Runs the whole comparison.
+/// Runs the whole comparison (or, with [`Config::merge`], [`Config::shard`] or
+/// [`Config::prepare`], that part of it).
 pub fn run(config: &Config) -> Result<(), Error> {
     let started = Instant::now();
+    let sharding = config.shard.is_some() || config.prepare || !config.merge.is_empty();
+    if sharding && config.paper_only() {
+        return Err(Error(
+            "--shard, --prepare and --merge split the default experiments; they do not go \
+             with --trees or --manylight"
+                .into(),
+        ));
+    }
+    if config.shard.is_some() && config.fresh {
+        return Err(Error(
+            "--fresh with --shard would recompute the references in every shard; run \
+             `--prepare --fresh` once first"
+                .into(),
+        ));
+    }
+    if !config.merge.is_empty() {
+        return shard::merge(&config.merge, &config.out);
+    }
     let presets = check(config)?;
     std::fs::create_dir_all(&config.out).map_err(|e| {
         Error(format!(
@@ -170,6 +231,13 @@ pub fn run(config: &Config) -> Result<(), Error> {
             config.out.display()
         ))
     })?;
+    let log_line = |msg: &str| eprintln!("{msg}");
+    if config.prepare {
+        return shard::prepare(config, &log_line);
+    }
+    if let Some(s) = config.shard {
+        return shard::run_shard(config, s, &log_line);
+    }
     let bar = sss_cli::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
     let log = |msg: &str| {
         if bar.is_hidden() {
@@ -205,7 +273,13 @@ pub fn run(config: &Config) -> Result<(), Error> {
         eprintln!("experiment {}", exp.name());
         sections.push(exp.run(&ctx)?);
     }
-    let report = assemble_report(config, &presets, &sections, started.elapsed().as_secs_f64());
+    let report = assemble_report(
+        config,
+        &presets,
+        &sections,
+        started.elapsed().as_secs_f64(),
+        None,
+    );
     let path = config.out.join("report.md");
     write_atomic(&path, report.as_bytes())?;
     eprintln!(
@@ -216,11 +290,13 @@ pub fn run(config: &Config) -> Result<(), Error> {
     Ok(())
 }
 
+/// `report.md` from the sections, with `note` (if any) after the opening paragraph.
 fn assemble_report(
     config: &Config,
     presets: &[&Preset],
     sections: &[Section],
     seconds: f64,
+    note: Option<&str>,
 ) -> String {
     let names: Vec<&str> = presets.iter().map(|p| p.name).collect();
     let mut s = String::new();
@@ -236,6 +312,10 @@ fn assemble_report(
         config.bins,
         100.0 * reference::R_MAX_ENERGY,
     ));
+    if let Some(note) = note {
+        s.push_str(note);
+        s.push_str("\n\n");
+    }
     s.push_str("## Summary\n\n");
     for sec in sections {
         s.push_str(&format!("### {}\n\n{}\n", sec.title, sec.summary));

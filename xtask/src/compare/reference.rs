@@ -255,7 +255,7 @@ pub fn load_or_compute(
     log: &dyn Fn(&str),
     bar: &indicatif::ProgressBar,
 ) -> Result<Vec<PresetReference>, Error> {
-    let dir = config.out.join("cache");
+    let dir = config.cache_dir();
     std::fs::create_dir_all(&dir)
         .map_err(|e| Error(format!("cannot create '{}': {e}", dir.display())))?;
     let mut out = Vec::with_capacity(presets.len());

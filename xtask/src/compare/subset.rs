@@ -75,7 +75,7 @@ pub fn subset_reference(
         )
         .as_bytes(),
     );
-    let dir = cfg.out.join("cache");
+    let dir = cfg.cache_dir();
     std::fs::create_dir_all(&dir)
         .map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
     let path = dir.join(format!("subset_{}_{key:016x}.txt", scene.name));

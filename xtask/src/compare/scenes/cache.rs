@@ -54,7 +54,7 @@ pub(in super::super) fn reference(
         )
         .as_bytes(),
     );
-    let dir = cfg.out.join("cache");
+    let dir = cfg.cache_dir();
     std::fs::create_dir_all(&dir)
         .map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
     let path = dir.join(format!("scene_{}_{key:016x}.exr", scene.name));
@@ -93,7 +93,21 @@ pub(in super::super) fn reference(
         coverage: out.coverage,
     };
     store(&path, &meta, out.width, out.height, &r)?;
-    Ok(r)
+    // The reference as the cache holds it (f32 in the EXR), not the render's f64: a run that
+    // renders the reference and one that reads it from the cache (a later run, or a shard)
+    // then score every method against the same numbers, bit for bit.
+    match load(&path, &meta, out.width, out.height) {
+        Ok(Some(stored)) => Ok(stored),
+        Ok(None) => Err(Error(format!(
+            "scene {}: the reference just written to {} is missing",
+            scene.name,
+            path.display()
+        ))),
+        Err(reason) => Err(Error(format!(
+            "scene {}: the reference just written does not read back ({reason})",
+            scene.name
+        ))),
+    }
 }
 
 /// Writes a reference: the EXR and its sidecar, then the `.txt` and its sidecar. An

@@ -1,10 +1,13 @@
-//! One timed run of a method, and `results.csv` (one row per run and thread count; columns
-//! documented in README.md). The stage columns follow the stages the runs report, in pipeline
+//! One timed run of a method, `results.csv` (one row per run and thread count; columns
+//! documented in README.md), and the lossless text records a shard writes of its runs
+//! ([`Run::record`]). The stage columns follow the stages the runs report, in pipeline
 //! order, so a new method's stages get their own columns.
 
 use super::super::Error;
+use super::super::host::Host;
 use super::super::output::csv_num;
 use sss_render::integrators::Integrator;
+use sss_render::integrators::METHODS;
 use sss_render::progress::NoProgress;
 use sss_render::render::{RenderOutput, RenderSettings, Stage, render};
 use sss_render::scene::Scene;
@@ -38,6 +41,8 @@ pub struct Run {
     pub param: &'static str,
     pub value: f64,
     pub threads: usize,
+    /// The machine the run was timed on.
+    pub host: Host,
     pub stages: Vec<Stage>,
     pub rmse: f64,
     pub rel_rmse: f64,
@@ -70,7 +75,7 @@ impl Run {
 
 /// The header of `results.csv` (documented in README.md).
 pub fn csv_header(stages: &[&str]) -> String {
-    let mut h = String::from("scene,method,param,value,threads,seconds_total");
+    let mut h = String::from("scene,method,param,value,threads,host,host_cores,seconds_total");
     for s in stages {
         let _ = write!(h, ",seconds_{s}");
     }
@@ -84,12 +89,14 @@ pub fn csv_rows(runs: &[Run]) -> String {
     for r in runs {
         let _ = write!(
             s,
-            "{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{}",
             r.scene,
             r.method,
             r.param,
             csv_num(Some(r.value)),
             r.threads,
+            r.host.cpu,
+            r.host.cores,
             csv_num(Some(r.seconds_total()))
         );
         for st in &stages {
@@ -107,6 +114,171 @@ pub fn csv_rows(runs: &[Run]) -> String {
         );
     }
     s
+}
+
+/// What one unit of the sweep gave: its runs (all threads first, then one thread where the
+/// unit has a one-thread run), or the reason the method cannot render the scene.
+#[derive(Clone, Debug)]
+pub enum UnitResult {
+    /// The unit's runs.
+    Runs(Vec<Run>),
+    /// The method cannot render the scene (why); the rest of its sweep there is not run.
+    Unsupported(String),
+}
+
+/// Escapes `text` as one field of a tab-separated record: `\\`, `\t`, `\n`, `\r`.
+pub fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '\\' => out.push_str("\\\\"),
+            '\t' => out.push_str("\\t"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The inverse of [`escape`]; `None` for a dangling or unknown escape.
+pub fn unescape(field: &str) -> Option<String> {
+    let mut out = String::with_capacity(field.len());
+    let mut chars = field.chars();
+    while let Some(c) = chars.next() {
+        if c != '\\' {
+            out.push(c);
+            continue;
+        }
+        out.push(match chars.next()? {
+            '\\' => '\\',
+            't' => '\t',
+            'n' => '\n',
+            'r' => '\r',
+            _ => return None,
+        });
+    }
+    Some(out)
+}
+
+/// A number as a record field: shortest round-trip notation (`NaN` and `inf` too), so a
+/// parsed record holds the same bits.
+fn num(v: f64) -> String {
+    format!("{v:e}")
+}
+
+/// An optional number: empty for none.
+fn opt_num(v: Option<f64>) -> String {
+    v.map(num).unwrap_or_default()
+}
+
+/// A stage name as `'static` (the render's stages are named by string literals): the name of a
+/// known stage where it is one, else the text kept for the rest of the process.
+fn stage_name(name: &str) -> &'static str {
+    const KNOWN: [&str; 5] = ["bvh", "gbuffer", "models", "shading", "opaque"];
+    KNOWN
+        .iter()
+        .find(|k| **k == name)
+        .copied()
+        .unwrap_or_else(|| Box::leak(name.to_string().into_boxed_str()))
+}
+
+impl Run {
+    /// The run as one line of tab-separated fields (no line break): scene, method, param,
+    /// value, threads, host, host cores, stages (`name=seconds` joined by `;`), rmse, relative
+    /// RMSE, fraction within ε, fraction within 3 SE (empty for none), mean ratio, then one
+    /// field per warning. Numbers in round-trip notation: [`Run::from_record`] gives the run
+    /// back bit for bit.
+    pub fn record(&self) -> String {
+        let stages: Vec<String> = self
+            .stages
+            .iter()
+            .map(|s| format!("{}={}", escape(s.name), num(s.seconds)))
+            .collect();
+        let mut fields = vec![
+            escape(&self.scene),
+            escape(self.method),
+            escape(self.param),
+            num(self.value),
+            self.threads.to_string(),
+            escape(&self.host.cpu),
+            self.host.cores.to_string(),
+            stages.join(";"),
+            num(self.rmse),
+            num(self.rel_rmse),
+            num(self.frac_within_eps),
+            opt_num(self.within_3se),
+            num(self.mean_ratio),
+        ];
+        fields.extend(self.warnings.iter().map(|w| escape(w)));
+        fields.join("\t")
+    }
+
+    /// Parses a line written by [`Run::record`]. The method must be a registered one (its
+    /// name and sweep label are taken from `METHODS`).
+    pub fn from_record(line: &str) -> Result<Run, String> {
+        let f: Vec<&str> = line.split('\t').collect();
+        if f.len() < 13 {
+            return Err(format!("{} fields, at least 13 expected", f.len()));
+        }
+        let text = |i: usize| unescape(f[i]).ok_or_else(|| format!("field {}: bad escape", i + 1));
+        let number = |i: usize| {
+            f[i].parse::<f64>()
+                .map_err(|_| format!("field {}: `{}` is not a number", i + 1, f[i]))
+        };
+        let count = |i: usize| {
+            f[i].parse::<usize>()
+                .map_err(|_| format!("field {}: `{}` is not a count", i + 1, f[i]))
+        };
+        let method_name = text(1)?;
+        let method = METHODS
+            .iter()
+            .find(|m| m.name == method_name)
+            .ok_or_else(|| format!("unknown method `{method_name}`"))?;
+        let param = text(2)?;
+        if param != method.sweep.label {
+            return Err(format!(
+                "method `{method_name}` sweeps `{}`, not `{param}`",
+                method.sweep.label
+            ));
+        }
+        let mut stages = Vec::new();
+        for part in f[7].split(';').filter(|p| !p.is_empty()) {
+            let (name, secs) = part
+                .split_once('=')
+                .ok_or_else(|| format!("stage `{part}` is not name=seconds"))?;
+            let name = unescape(name).ok_or("stage name: bad escape")?;
+            let seconds = secs
+                .parse::<f64>()
+                .map_err(|_| format!("stage `{part}`: bad seconds"))?;
+            stages.push(Stage {
+                name: stage_name(&name),
+                seconds,
+            });
+        }
+        Ok(Run {
+            scene: text(0)?,
+            method: method.name,
+            param: method.sweep.label,
+            value: number(3)?,
+            threads: count(4)?,
+            host: Host {
+                cpu: text(5)?,
+                cores: count(6)?,
+            },
+            stages,
+            rmse: number(8)?,
+            rel_rmse: number(9)?,
+            frac_within_eps: number(10)?,
+            within_3se: if f[11].is_empty() {
+                None
+            } else {
+                Some(number(11)?)
+            },
+            mean_ratio: number(12)?,
+            warnings: (13..f.len()).map(text).collect::<Result<_, _>>()?,
+        })
+    }
 }
 
 /// What one run gave.
@@ -148,6 +320,10 @@ mod tests {
             param: "p",
             value: 1.0,
             threads: 1,
+            host: Host {
+                cpu: "test cpu".into(),
+                cores: 2,
+            },
             stages: stages
                 .iter()
                 .map(|&name| Stage { name, seconds: 1.0 })
@@ -229,5 +405,63 @@ mod tests {
                 "{col} missing from {h}"
             );
         }
+    }
+
+    /// A run written as a record and read back is the same run, bit for bit, whatever its
+    /// text holds; records that are not runs are refused with the reason.
+    #[test]
+    fn records_round_trip() {
+        let mut r = run(&["bvh", "gbuffer", "irradiance_tree", "shading"]);
+        r.method = METHODS[1].name;
+        r.param = METHODS[1].sweep.label;
+        r.scene = "a\tscene\\with\nbreaks".into();
+        r.value = 0.1 + 0.2;
+        r.rmse = 1.0 / 3.0;
+        r.rel_rmse = f64::MIN_POSITIVE;
+        r.within_3se = Some(0.7);
+        r.mean_ratio = 1.0 + f64::EPSILON;
+        r.stages[2].seconds = 1e-300;
+        r.host.cpu = "cpu, with comma\tand tab".into();
+        r.warnings = vec!["cap bound\t(spacing 2)".into(), String::new(), "\\n".into()];
+        let line = r.record();
+        assert!(!line.contains('\n'));
+        let back = Run::from_record(&line).unwrap();
+        assert_eq!(back.record(), line);
+        assert_eq!(back.scene, r.scene);
+        assert_eq!(back.method, r.method);
+        assert_eq!(back.value.to_bits(), r.value.to_bits());
+        assert_eq!(back.rmse.to_bits(), r.rmse.to_bits());
+        assert_eq!(back.rel_rmse.to_bits(), r.rel_rmse.to_bits());
+        assert_eq!(back.mean_ratio.to_bits(), r.mean_ratio.to_bits());
+        assert_eq!(back.within_3se, r.within_3se);
+        assert_eq!(back.host, r.host);
+        assert_eq!(back.warnings, r.warnings);
+        let names: Vec<&str> = back.stages.iter().map(|s| s.name).collect();
+        assert_eq!(names, ["bvh", "gbuffer", "irradiance_tree", "shading"]);
+        assert_eq!(back.stages[2].seconds, 1e-300);
+        r.within_3se = None;
+        assert_eq!(Run::from_record(&r.record()).unwrap().within_3se, None);
+
+        let fields: Vec<String> = line.split('\t').map(String::from).collect();
+        let with = |i: usize, v: &str| {
+            let mut f = fields.clone();
+            f[i] = v.into();
+            Run::from_record(&f.join("\t")).unwrap_err()
+        };
+        assert!(with(1, "nope").contains("unknown method `nope`"));
+        assert!(with(2, "taps").contains("sweeps"));
+        assert!(with(3, "x").contains("field 4"));
+        assert!(with(4, "-1").contains("not a count"));
+        assert!(with(7, "bvh").contains("name=seconds"));
+        assert!(with(0, "bad\\q").contains("bad escape"));
+        assert!(
+            Run::from_record("a\tb")
+                .unwrap_err()
+                .contains("at least 13")
+        );
+        for text in ["", "plain", "\\", "\t\n\r\\\\t"] {
+            assert_eq!(unescape(&escape(text)).as_deref(), Some(text));
+        }
+        assert_eq!(unescape("dangling\\"), None);
     }
 }
