@@ -599,7 +599,8 @@ impl<'a> Estimator<'a> {
             let (vi, p) = self.lights.sample(l, rng.next_f64());
             let xo = shading.points()[shading.sample(s, rng.next_f64()) as usize].position;
             let u = [rng.next_f64(), rng.next_f64(), rng.next_f64()];
-            let (xi, ni) = refs.sample(self.surface, i, u);
+            let at = refs.sample(self.surface, i, u);
+            let (xi, ni) = (at.position, at.normal);
             let vpl = &self.lights.vpls()[vi as usize];
             let lum = vpl.scalar_intensity();
             if p <= 0.0 || lum <= 0.0 {
@@ -619,7 +620,10 @@ impl<'a> Estimator<'a> {
             // vertex of the surface lights the triangles around it edge-on) contributes
             // nothing: cos θ_i below GRAZING_COS counts as 0 (its true weight, cos θ_i ·
             // F_t(cos θ_i) ~ cos², is below 10⁻¹⁸ there).
-            if cos_i <= GRAZING_COS || cos_y <= 0.0 {
+            // The light must also be above the triangle's own plane, as in the renderer: a
+            // shading normal may face a light that the flat triangle turns its back on (or, to
+            // rounding, lies in its plane).
+            if cos_i <= GRAZING_COS || cos_y <= 0.0 || at.geometric.dot(dir) <= GRAZING_COS {
                 continue;
             }
             if d2 < 1.0 / g_max {

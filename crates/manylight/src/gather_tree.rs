@@ -118,10 +118,10 @@ pub fn uniform_points(
     let area = surface.area() / n as f64;
     for _ in 0..n {
         let u = [next(), next(), next()];
-        let (position, normal) = surface.sample_uniform(u);
+        let at = surface.sample_uniform(u);
         out.push(IrradiancePoint {
-            position,
-            normal,
+            position: at.position,
+            normal: at.normal,
             area,
         });
     }

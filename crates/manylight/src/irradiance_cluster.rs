@@ -2,6 +2,25 @@
 //! sampling inside a cluster (Nabata & Iwasaki Eq. 7) and the refinement of a single-triangle
 //! cluster by halving its longest edge (§4.3, Fig. 2(d)) in a per-pixel side arena, so the
 //! shared tree is never rebuilt or mutated.
+//!
+//! # Shading normals
+//!
+//! A mesh that approximates a smooth surface carries per-vertex normals, and the irradiance
+//! at a point of a triangle is taken against the normal interpolated there (Phong's
+//! interpolation: the barycentric blend of the vertex normals, normalised), as the renderer's
+//! `exact` and `pathtrace` take it. Taking the flat triangle's own normal instead changes the
+//! light every point receives: on a 100 000-triangle scanned dragon in skin1 (standard dipole,
+//! one point light, 48², 4 samples per pixel) the image mean of the flat-normal estimate was
+//! 0.990 of `exact`'s and 0.985–0.991 of a path trace's (1 024 samples per pixel) per channel
+//! at ε = 1 % (0.9905 at ε = 0.1 %, 96²), while with the mesh's normals replaced by its face
+//! normals in every method the two agreed within 0.07 %; on an icosahedron with radial vertex
+//! normals it was 7.6 % above the path trace. With the interpolated normals the dragon's ratio
+//! to `exact` is 1.0000–1.0006 and the icosahedron's to the path trace 0.998–1.0006. [`IrradianceTree::with_normals`] keeps the vertex
+//! normals; [`Triangle::halve`] gives the new vertex the average of its edge's two (not
+//! normalised), so the halves interpolate exactly as their parent did; a cluster's normal cone
+//! holds every interpolated normal of its triangles. A light reaches a point only where it is
+//! above both the shading normal and the triangle's own plane (the renderer's rule: a shadow
+//! ray cannot leave a flat triangle on its back side).
 
 use std::collections::HashMap;
 
@@ -12,8 +31,20 @@ use crate::aabb::Aabb;
 use crate::binary_tree::{descend, median_split};
 use crate::cone::NormalCone;
 
-/// A triangle with its area and unit geometric normal (from the winding: counter-clockwise seen
-/// from the side the normal points to; the estimator treats that side as outside).
+/// A point drawn on the surface, with the normals the irradiance there is taken against.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceSample {
+    /// The point.
+    pub position: DVec3,
+    /// Unit shading normal: the triangle's vertex normals interpolated at the point.
+    pub normal: DVec3,
+    /// Unit geometric normal of the triangle (zero for a degenerate one).
+    pub geometric: DVec3,
+}
+
+/// A triangle with its area, unit geometric normal (from the winding: counter-clockwise seen
+/// from the side the normal points to; the estimator treats that side as outside) and the
+/// shading normals at its vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Triangle {
     /// Vertices.
@@ -23,17 +54,37 @@ pub struct Triangle {
     pub area: f64,
     /// Unit normal (zero for a degenerate triangle).
     pub normal: DVec3,
+    /// Shading normals at the vertices, blended barycentrically and normalised at a point
+    /// ([`Triangle::shading_normal`]). Unit for mesh triangles; a split's new vertex holds the
+    /// plain average of two, so not always unit. All three equal `normal` for a flat triangle.
+    pub vertex_normals: [DVec3; 3],
 }
 
 impl Triangle {
-    /// The triangle `a b c`, with its area and normal.
+    /// The flat triangle `a b c`, with its area and normal (every vertex normal equal to it).
     pub fn new(a: DVec3, b: DVec3, c: DVec3) -> Triangle {
         let n = (b - a).cross(c - a);
+        let normal = n.normalize_or_zero();
         Triangle {
             v: [a, b, c],
             area: 0.5 * n.length(),
-            normal: n.normalize_or_zero(),
+            normal,
+            vertex_normals: [normal; 3],
         }
+    }
+
+    /// The triangle `a b c` with shading normals `n` at its vertices (each normalised; one that
+    /// is zero or not finite is replaced by the triangle's own normal).
+    pub fn with_normals(a: DVec3, b: DVec3, c: DVec3, n: [DVec3; 3]) -> Triangle {
+        let mut t = Triangle::new(a, b, c);
+        t.vertex_normals = n.map(|v| {
+            if v.is_finite() {
+                v.normalize_or(t.normal)
+            } else {
+                t.normal
+            }
+        });
+        t
     }
 
     /// The box of the vertices.
@@ -41,43 +92,111 @@ impl Triangle {
         Aabb::of_points(&self.v)
     }
 
+    /// The barycentric coordinates (of `v[0]`, `v[1]`) of a uniformly distributed point from
+    /// two uniforms in [0, 1) (the square-root parameterisation; Turk 1990, pbrt 3rd ed.
+    /// §13.6.5).
+    #[inline]
+    fn barycentric(u1: f64, u2: f64) -> (f64, f64) {
+        let s = u1.sqrt();
+        (1.0 - s, u2 * s)
+    }
+
     /// A uniformly distributed point from two uniforms in [0, 1) (the square-root
     /// parameterisation; Turk 1990, pbrt 3rd ed. §13.6.5).
     #[inline]
     pub fn sample(&self, u1: f64, u2: f64) -> DVec3 {
-        let s = u1.sqrt();
-        let (b0, b1) = (1.0 - s, u2 * s);
+        let (b0, b1) = Self::barycentric(u1, u2);
         b0 * self.v[0] + b1 * self.v[1] + (1.0 - b0 - b1) * self.v[2]
     }
 
-    /// The cone of its one normal (half-angle 0), `None` for a degenerate triangle.
+    /// The unit shading normal at barycentric coordinates (`b0`, `b1`) of `v[0]`, `v[1]`: the
+    /// blend of the vertex normals, normalised (the triangle's own normal where the blend
+    /// vanishes).
+    #[inline]
+    pub fn shading_normal(&self, b0: f64, b1: f64) -> DVec3 {
+        let [n0, n1, n2] = self.vertex_normals;
+        if n0 == n1 && n1 == n2 {
+            // One normal (a flat triangle): itself, unblended, so a flat mesh gets its face
+            // normals bit for bit.
+            return if n0 == self.normal {
+                n0
+            } else {
+                n0.normalize_or(self.normal)
+            };
+        }
+        (b0 * n0 + b1 * n1 + (1.0 - b0 - b1) * n2).normalize_or(self.normal)
+    }
+
+    /// A uniformly distributed point ([`Triangle::sample`] of the same uniforms) with its
+    /// shading and geometric normals.
+    #[inline]
+    pub fn sample_with_normals(&self, u1: f64, u2: f64) -> SurfaceSample {
+        let (b0, b1) = Self::barycentric(u1, u2);
+        SurfaceSample {
+            position: b0 * self.v[0] + b1 * self.v[1] + (1.0 - b0 - b1) * self.v[2],
+            normal: self.shading_normal(b0, b1),
+            geometric: self.normal,
+        }
+    }
+
+    /// A cone holding every shading normal of the triangle (half-angle 0 for a flat one),
+    /// `None` for a degenerate triangle. A normalised blend of the vertex normals lies in any
+    /// cone holding them; where they spread over a half-angle of π/2 or more the blend may
+    /// vanish and fall back to the triangle's normal, so the cone holds that too.
     pub fn cone(&self) -> Option<NormalCone> {
-        (self.normal != DVec3::ZERO).then_some(NormalCone {
-            axis: self.normal,
+        if self.normal == DVec3::ZERO {
+            return None;
+        }
+        let point = |axis: DVec3| NormalCone {
+            axis,
             half_angle: 0.0,
+        };
+        let [n0, n1, n2] = self.vertex_normals;
+        if n0 == n1 && n1 == n2 {
+            // One normal: the cone of [`Triangle::shading_normal`]'s one value.
+            return Some(point(self.shading_normal(1.0, 0.0)));
+        }
+        let unit = |n: DVec3| n.normalize_or(self.normal);
+        let cone = point(unit(n0))
+            .union(point(unit(n1)))
+            .union(point(unit(n2)));
+        Some(if cone.half_angle >= std::f64::consts::FRAC_PI_2 {
+            cone.union(point(self.normal))
+        } else {
+            cone
         })
     }
 
     /// The two halves cut at the midpoint of the longest edge, both with the parent's winding
-    /// and each with exactly half its area.
+    /// and each with exactly half its area. The new vertex's normal is the average of the
+    /// edge's two, so every point of a half has the shading normal it had in the parent.
     pub fn halve(&self) -> [Triangle; 2] {
         let len = |i: usize| (self.v[(i + 1) % 3] - self.v[i]).length_squared();
         let i = (0..3)
             .max_by(|&a, &b| len(a).total_cmp(&len(b)).then(b.cmp(&a)))
             .unwrap_or(0);
-        let (p, q, o) = (self.v[i], self.v[(i + 1) % 3], self.v[(i + 2) % 3]);
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        let (p, q, o) = (self.v[i], self.v[j], self.v[k]);
+        let [np, nq, no] = [
+            self.vertex_normals[i],
+            self.vertex_normals[j],
+            self.vertex_normals[k],
+        ];
         let m = 0.5 * (p + q);
+        let nm = 0.5 * (np + nq);
         let half = 0.5 * self.area;
         [
             Triangle {
                 v: [p, m, o],
                 area: half,
                 normal: self.normal,
+                vertex_normals: [np, nm, no],
             },
             Triangle {
                 v: [m, q, o],
                 area: half,
                 normal: self.normal,
+                vertex_normals: [nm, nq, no],
             },
         ]
     }
@@ -117,9 +236,37 @@ pub enum IcId {
 }
 
 impl IrradianceTree {
-    /// Builds the BVH of a mesh. Errors: no triangles, an index out of range, a non-finite
-    /// position, or zero total area. Degenerate triangles are kept (area 0: never sampled).
+    /// Builds the BVH of a mesh of flat triangles (each point's normal is its triangle's).
+    /// Errors: no triangles, an index out of range, a non-finite position, or zero total area.
+    /// Degenerate triangles are kept (area 0: never sampled).
     pub fn new(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<IrradianceTree, Error> {
+        IrradianceTree::build(positions, None, triangles)
+    }
+
+    /// Builds the BVH of a mesh with a shading normal per vertex (`normals[k]` at
+    /// `positions[k]`), interpolated over each triangle (see the module documentation). Errors
+    /// as [`IrradianceTree::new`], and a normal count other than the position count. A normal
+    /// that is zero or not finite is replaced by its triangle's own normal.
+    pub fn with_normals(
+        positions: &[DVec3],
+        normals: &[DVec3],
+        triangles: &[[u32; 3]],
+    ) -> Result<IrradianceTree, Error> {
+        if normals.len() != positions.len() {
+            return Err(Error::InvalidInput(format!(
+                "{} normals for {} vertices",
+                normals.len(),
+                positions.len()
+            )));
+        }
+        IrradianceTree::build(positions, Some(normals), triangles)
+    }
+
+    fn build(
+        positions: &[DVec3],
+        normals: Option<&[DVec3]>,
+        triangles: &[[u32; 3]],
+    ) -> Result<IrradianceTree, Error> {
         if triangles.is_empty() {
             return Err(Error::InvalidInput("mesh without triangles".into()));
         }
@@ -144,7 +291,10 @@ impl IrradianceTree {
                     ))
                 })?;
             }
-            tris.push(Triangle::new(v[0], v[1], v[2]));
+            tris.push(match normals {
+                Some(n) => Triangle::with_normals(v[0], v[1], v[2], idx.map(|k| n[k as usize])),
+                None => Triangle::new(v[0], v[1], v[2]),
+            });
         }
         let total: f64 = tris.iter().map(|t| t.area).sum();
         if !(total.is_finite() && total > 0.0) {
@@ -205,8 +355,8 @@ impl IrradianceTree {
 
     /// A point uniformly distributed by area over the whole mesh (density 1/A, Eq. 7 at the
     /// root) from three uniforms in [0, 1): a triangle in proportion to its area, then a uniform
-    /// point on it. Returns the point and the triangle's normal.
-    pub fn sample_uniform(&self, u: [f64; 3]) -> (DVec3, DVec3) {
+    /// point on it, with its shading and geometric normals.
+    pub fn sample_uniform(&self, u: [f64; 3]) -> SurfaceSample {
         let nodes = &self.nodes;
         let (leaf, _) = descend(
             0,
@@ -215,7 +365,7 @@ impl IrradianceTree {
             |k| nodes[k as usize].area,
         );
         let tri = &self.triangles[nodes[leaf as usize].triangle as usize];
-        (tri.sample(u[1], u[2]), tri.normal)
+        tri.sample_with_normals(u[1], u[2])
     }
 }
 
@@ -383,9 +533,9 @@ impl Refinements {
     }
 
     /// Samples a point uniformly (density 1/A_j, Eq. 7) in a cluster from three uniforms:
-    /// a triangle in proportion to area (descending the BVH), then a uniform point on it.
-    /// Returns the point and the triangle's normal.
-    pub fn sample(&self, tree: &IrradianceTree, id: IcId, u: [f64; 3]) -> (DVec3, DVec3) {
+    /// a triangle in proportion to area (descending the BVH), then a uniform point on it, with
+    /// its shading and geometric normals.
+    pub fn sample(&self, tree: &IrradianceTree, id: IcId, u: [f64; 3]) -> SurfaceSample {
         let tri = match id {
             IcId::Split(k) => &self.nodes[k as usize].triangle,
             IcId::Base(n) => {
@@ -399,6 +549,6 @@ impl Refinements {
                 &tree.triangles[nodes[leaf as usize].triangle as usize]
             }
         };
-        (tri.sample(u[1], u[2]), tri.normal)
+        tri.sample_with_normals(u[1], u[2])
     }
 }

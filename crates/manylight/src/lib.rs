@@ -105,7 +105,7 @@ pub use estimator::{Estimator, Interval, PixelEstimate, Settings, Status, Visibi
 pub use gather_tree::{
     GatherNode, GatherPoint, GatherTree, IrradiancePoint, gather_points, uniform_points,
 };
-pub use irradiance_cluster::{IcId, IrradianceTree, Refinements, Triangle};
+pub use irradiance_cluster::{IcId, IrradianceTree, Refinements, SurfaceSample, Triangle};
 pub use mdlc::{CutPair, Mdlc, MdlcSettings};
 pub use profile::{LUMINANCE, RadialProfile, Transmittance, luminance};
 pub use shading_cluster::{ShadingPoint, ShadingTree};

@@ -210,7 +210,8 @@ fn cluster_sampling_is_uniform_in_area() {
     let mut count = [0usize; 3];
     let mut left_half = 0usize;
     for _ in 0..n {
-        let (p, nrm) = refs.sample(&tree, tree.root(), [u.f(), u.f(), u.f()]);
+        let at = refs.sample(&tree, tree.root(), [u.f(), u.f(), u.f()]);
+        let (p, nrm) = (at.position, at.normal);
         assert_eq!(nrm.z.abs(), 1.0);
         let k = if p.x <= 1.0 {
             0
@@ -254,4 +255,140 @@ fn bad_meshes_are_errors() {
     assert!(LightTree::new(vec![]).is_err());
     assert!(LightTree::new(vec![Vpl::point(DVec3::ZERO, [1.0, -1.0, 0.0])]).is_err());
     assert!(LightTree::new(vec![Vpl::oriented(DVec3::ZERO, DVec3::ZERO, [1.0; 3])]).is_err());
+}
+
+/// The barycentric coordinates of `p` (in the triangle's plane) in `t`, from sub-triangle
+/// areas: independent of the sampler's parameterisation.
+fn barycentric_of(t: &Triangle, p: DVec3) -> [f64; 3] {
+    let area = |a: DVec3, b: DVec3, c: DVec3| 0.5 * (b - a).cross(c - a).length();
+    let whole = area(t.v[0], t.v[1], t.v[2]);
+    [
+        area(p, t.v[1], t.v[2]) / whole,
+        area(t.v[0], p, t.v[2]) / whole,
+        area(t.v[0], t.v[1], p) / whole,
+    ]
+}
+
+/// Phong's normal at `p`: the vertex normals blended by `p`'s barycentric coordinates,
+/// normalised.
+fn phong(t: &Triangle, p: DVec3) -> DVec3 {
+    let b = barycentric_of(t, p);
+    (b[0] * t.vertex_normals[0] + b[1] * t.vertex_normals[1] + b[2] * t.vertex_normals[2])
+        .normalize()
+}
+
+/// A sample's shading normal is the vertex normals blended at the sampled point; halving keeps
+/// every point's normal (the halves blend as their parent did), and every normal lies in the
+/// triangle's cone. A flat triangle keeps its one normal and a cone of half-angle 0.
+#[test]
+fn shading_normals_interpolate_and_survive_halving() {
+    let mut u = U(7);
+    for trial in 0..300 {
+        let p: [DVec3; 3] = std::array::from_fn(|_| DVec3::new(u.f(), u.f(), u.f()) * 2.0 - 1.0);
+        let flat = Triangle::new(p[0], p[1], p[2]);
+        // Vertex normals tilted up to about 60° from the face normal.
+        let n: [DVec3; 3] = std::array::from_fn(|_| {
+            (flat.normal + DVec3::new(u.f(), u.f(), u.f()) * 1.6 - 0.8).normalize()
+        });
+        let t = Triangle::with_normals(p[0], p[1], p[2], n);
+        assert_eq!(t.area, flat.area);
+        assert_eq!(t.normal, flat.normal);
+        let cone = t.cone().unwrap();
+        // Follow a random chain of halvings; at each level, sample the current piece and
+        // compare its shading normal with the ORIGINAL triangle's blend at that point.
+        let mut piece = t;
+        for level in 0..8 {
+            for _ in 0..8 {
+                let s = piece.sample_with_normals(u.f(), u.f());
+                assert_eq!(s.geometric, t.normal);
+                let want = phong(&t, s.position);
+                assert!(
+                    s.normal.distance(want) < 1e-9,
+                    "trial {trial} level {level}: {} vs {want}",
+                    s.normal
+                );
+                assert!((s.normal.length() - 1.0).abs() < 1e-12);
+                let angle = s.normal.dot(cone.axis).clamp(-1.0, 1.0).acos();
+                assert!(
+                    angle <= cone.half_angle + 1e-9,
+                    "trial {trial}: outside the cone"
+                );
+                let piece_cone = piece.cone().unwrap();
+                let a = s.normal.dot(piece_cone.axis).clamp(-1.0, 1.0).acos();
+                assert!(
+                    a <= piece_cone.half_angle + 1e-9,
+                    "outside the piece's cone"
+                );
+            }
+            piece = piece.halve()[(u.f() * 2.0) as usize];
+        }
+        let fc = flat.cone().unwrap();
+        assert_eq!((fc.axis, fc.half_angle), (flat.normal, 0.0));
+        let s = flat.sample_with_normals(u.f(), u.f());
+        assert_eq!(s.normal, flat.normal);
+        for h in flat.halve() {
+            assert_eq!(h.vertex_normals, [flat.normal; 3]);
+        }
+    }
+    // Zero and non-finite vertex normals fall back to the face normal.
+    let t = Triangle::with_normals(
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Y,
+        [DVec3::ZERO, DVec3::NAN, DVec3::new(0.0, 0.0, 2.0)],
+    );
+    assert_eq!(t.vertex_normals, [DVec3::Z; 3]);
+}
+
+/// A tree built with a mesh's vertex normals samples Phong's normal: on an octahedron with
+/// radial vertex normals the blended normal at a point is the point's own direction.
+#[test]
+fn tree_samples_carry_the_mesh_normals() {
+    let pos = [
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ];
+    let tris = [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let tree = IrradianceTree::with_normals(&pos, &pos, &tris).unwrap();
+    let flat = IrradianceTree::new(&pos, &tris).unwrap();
+    let mut refs = Refinements::new(64);
+    let mut u = U(11);
+    let mut max_tilt: f64 = 0.0;
+    for _ in 0..2000 {
+        let w = [u.f(), u.f(), u.f()];
+        let s = tree.sample_uniform(w);
+        assert!(s.normal.distance(s.position.normalize()) < 1e-12);
+        let f = flat.sample_uniform(w);
+        assert_eq!(f.position, s.position, "the same point either way");
+        assert_eq!(f.normal, f.geometric);
+        assert_eq!(s.geometric, f.geometric);
+        max_tilt = max_tilt.max(s.normal.angle_between(s.geometric));
+        // The same through a refined cluster.
+        let root = tree.root();
+        let [a, _] = refs.split(&tree, root).unwrap();
+        let r = refs.sample(&tree, a, [u.f(), u.f(), u.f()]);
+        assert!(r.normal.distance(r.position.normalize()) < 1e-12);
+        let cone = refs.cone(&tree, a).unwrap();
+        assert!(r.normal.angle_between(cone.axis) <= cone.half_angle + 1e-9);
+    }
+    // Near a vertex the radial normal is 54.7° from the face normal.
+    assert!(max_tilt > 0.8, "{max_tilt}");
+    let e = IrradianceTree::with_normals(&pos, &pos[..5], &tris).unwrap_err();
+    assert!(
+        format!("{e:?}").contains("5 normals for 6 vertices"),
+        "{e:?}"
+    );
 }

@@ -20,9 +20,13 @@
 //! interface, e_k = 0, gets 0).
 //!
 //! **What differs from `exact`.** `exact` sums point irradiance samples lit by the renderer's
-//! light sampling; this integrates the irradiance over the triangles (Eq. 7) with the triangles'
-//! geometric normals, under the VPL approximation of area and environment lights. Both are
-//! consistent estimators of the same integral; at small ε and many VPLs they agree.
+//! light sampling; this integrates the irradiance over the triangles (Eq. 7), under the VPL
+//! approximation of area and environment lights. Both take cos θ_i against the mesh's
+//! interpolated shading normal, and let light in only above the triangle's own plane too; they
+//! are consistent estimators of the same integral, and at small ε and many VPLs they agree.
+//! (With the flat triangles' normals instead, the image mean was 1 % below `exact` and a path
+//! trace on a scanned 100 000-triangle dragon, 7.6 % above on a 20-face icosahedron:
+//! `sss_manylight::irradiance_cluster` has the measurement.)
 //!
 //! **G clamp.** G = cos θ_i cos θ_y min(1/d², G_max) with
 //! [`Settings::g_max_for_scene`] of the geometry's half-diagonal: d² ≥ (0.05 × half-diagonal)²,
@@ -352,7 +356,9 @@ pub(crate) fn object_data(
             continue;
         };
         let mesh = &scene.objects[o as usize].mesh;
-        let tree = IrradianceTree::new(&mesh.positions, &mesh.triangles)
+        // The mesh's shading normals, as `exact` and `pathtrace` use them (see
+        // `sss_manylight::irradiance_cluster`).
+        let tree = IrradianceTree::with_normals(&mesh.positions, &mesh.normals, &mesh.triangles)
             .map_err(|e| model_error(scene, o, method, e))?;
         // R_d in scene units as `rd_scene` computes it: R_d(r/u)/u², u = units per mm. The
         // profile must own its model, so the material's model is built again here.
