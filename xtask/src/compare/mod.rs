@@ -18,6 +18,7 @@ mod checked;
 mod host;
 mod kernels;
 mod manylight;
+mod mcml;
 mod metrics;
 mod output;
 mod profiles;

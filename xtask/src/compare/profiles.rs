@@ -4,7 +4,9 @@
 //! over the reference's bins are compared with the Monte Carlo bins ([`super::metrics`]), its
 //! total diffuse reflectance with the Monte Carlo total, and its evaluation cost is timed.
 //! Writes `profiles.csv`, `profile_<preset>.png`, `error_<preset>.png` and
-//! `error_vs_cost.png`, and returns the report section.
+//! `error_vs_cost.png`, and returns the report section. Where the shared MCML profiles exist
+//! ([`super::mcml`]), every model is also compared with MCML, an independent Monte Carlo code
+//! (Wang, Jacques & Zheng 1995), in a subsection of its own and `mcml.csv`.
 //!
 //! To add a method (e.g. a fitted kernel from a later crate), implement [`ProfileMethod`] and
 //! add it to [`methods`].
@@ -14,7 +16,7 @@ use super::metrics::{
 };
 use super::output::{csv_num, md_num, md_pct, md_table, write_atomic};
 use super::reference::{CHANNEL_NAMES, McPart, PresetReference};
-use super::{Context, Error, Experiment, Section};
+use super::{Context, Error, Experiment, Section, mcml};
 use sss_bssrdf::mc_table::McTable;
 use sss_bssrdf::photon_beam_diffusion::PbdTable;
 use sss_bssrdf::{Bssrdf, Medium, ModelKind, make_model};
@@ -546,6 +548,9 @@ impl Experiment for ProfileComparison {
             results_csv(&evals).as_bytes(),
         )?;
         plot_error_vs_cost(ctx, &evals, &method_names)?;
+        let mcml = mcml::run(&mcml::reference_dir(), &ctx.config.out)?;
+        (ctx.log)("profiles: compared with MCML");
+        body.push_str(&mcml.body);
         let mut summary = String::new();
         let _ = writeln!(
             summary,
@@ -589,6 +594,7 @@ impl Experiment for ProfileComparison {
              the two η tables it blends).",
             100.0 * MAX_REL_SE
         );
+        let _ = write!(summary, "\n{}", mcml.summary);
         Ok(Section {
             title: "Models against the Monte Carlo reference".into(),
             summary,
