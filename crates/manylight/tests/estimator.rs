@@ -304,3 +304,36 @@ fn bad_settings_are_errors() {
         assert!(matches!(r, Err(Error::InvalidInput(_))), "{st:?}");
     }
 }
+
+/// A light below a triangle's own plane lights nothing, even where the interpolated shading
+/// normals lean towards it (the renderer's rule: a shadow ray cannot leave a flat triangle on
+/// its back side); the same light just above the plane lights it, through the shading normal.
+#[test]
+fn a_light_below_the_plane_is_dark_whatever_the_shading_normals() {
+    let pos = [DVec3::ZERO, DVec3::X, DVec3::Y]; // counter-clockwise from +z: normal +z
+    let lean = DVec3::new(1.0, 0.0, 0.2).normalize();
+    let surface = IrradianceTree::with_normals(&pos, &[lean; 3], &[[0, 1, 2]]).unwrap();
+    let profile = RadialProfile::new(|r| [(-r).exp(); 3], 4.0).unwrap();
+    let ft = Transmittance::one();
+    let t = StudentT::new(0.95).unwrap();
+    let shading = ShadingTree::new(vec![ShadingPoint {
+        position: DVec3::new(0.3, 0.3, 0.0),
+        normal: DVec3::Z,
+        weight: 1.0,
+    }])
+    .unwrap();
+    let open_sky = |_: DVec3, _: DVec3| true;
+    for (z, lit) in [(-0.1, false), (0.1, true)] {
+        let light = DVec3::new(3.0, 0.3, z);
+        // Every direction to the light is within 10° of +x: the shading normal faces it.
+        assert!(lean.dot((light - DVec3::new(0.5, 0.5, 0.0)).normalize()) > 0.9);
+        let lights = LightTree::new(vec![Vpl::point(light, [1.0; 3])]).unwrap();
+        let mut st = Settings::new(100.0);
+        st.epsilon = 0.0;
+        st.max_triplets = 64;
+        let est = Estimator::new(&lights, &surface, &profile, &ft, &t, st).unwrap();
+        let px = est.estimate(&shading, &open_sky, pixel_seed(1, 0));
+        assert!(px.value.is_finite() && px.value >= 0.0);
+        assert_eq!(px.value > 0.0, lit, "light at z = {z}: {}", px.value);
+    }
+}
