@@ -330,6 +330,35 @@ fn shading_normals_interpolate_and_survive_halving() {
             assert_eq!(h.vertex_normals, [flat.normal; 3]);
         }
     }
+    // Two vertex normals equal and the third not: still blended (not the shared one).
+    let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
+    let up = DVec3::Z;
+    let tilted = DVec3::new(0.6, 0.0, 0.8);
+    for n in [[up, up, tilted], [tilted, up, up], [up, tilted, up]] {
+        let t = Triangle::with_normals(a, b, c, n);
+        let mut u = U(5);
+        for _ in 0..50 {
+            let s = t.sample_with_normals(u.f(), u.f());
+            assert!(s.normal.distance(phong(&t, s.position)) < 1e-9, "{n:?}");
+            let cone = t.cone().unwrap();
+            let angle = s.normal.dot(cone.axis).clamp(-1.0, 1.0).acos();
+            assert!(angle <= cone.half_angle + 1e-9, "{n:?}: outside the cone");
+        }
+    }
+    // The point-only sampler gives the same points as the sampler with normals, inside the
+    // triangle.
+    let t = Triangle::with_normals(a, b, c, [up, up, tilted]);
+    let mut u = U(6);
+    for _ in 0..100 {
+        let (u1, u2) = (u.f(), u.f());
+        let p = t.sample(u1, u2);
+        assert_eq!(p, t.sample_with_normals(u1, u2).position);
+        let bary = barycentric_of(&t, p);
+        assert!(
+            (bary.iter().sum::<f64>() - 1.0).abs() < 1e-12,
+            "{p} outside"
+        );
+    }
     // Zero and non-finite vertex normals fall back to the face normal.
     let t = Triangle::with_normals(
         DVec3::ZERO,
