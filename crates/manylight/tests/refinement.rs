@@ -345,6 +345,13 @@ fn shading_normals_interpolate_and_survive_halving() {
             assert!(angle <= cone.half_angle + 1e-9, "{n:?}: outside the cone");
         }
     }
+    // Vertex normals leaning together 50° off the face normal: the cone is theirs alone, not
+    // widened to the face normal (which no interpolated normal reaches).
+    let lean = |dx: f64, dy: f64| DVec3::new(0.766 + dx, dy, 0.643).normalize();
+    let t = Triangle::with_normals(a, b, c, [lean(0.0, 0.0), lean(0.02, 0.0), lean(0.0, 0.02)]);
+    let cone = t.cone().unwrap();
+    assert!(cone.half_angle < 0.05, "{}", cone.half_angle);
+    assert!(cone.axis.angle_between(up) > 0.8);
     // The point-only sampler gives the same points as the sampler with normals, inside the
     // triangle.
     let t = Triangle::with_normals(a, b, c, [up, up, tilted]);
