@@ -121,12 +121,7 @@ fn agrees_with_brute_force_within_its_intervals() {
     let m = integrators::build("manylight", &MethodOptions::new().with("eps", eps)).unwrap();
     let out = render(&s, m.as_ref(), &settings, &NoProgress).unwrap();
     let se = out.std_error.as_ref().unwrap();
-    let triplets = &out
-        .layers
-        .iter()
-        .find(|l| l.name == "triplets")
-        .unwrap()
-        .pixels;
+    let triplets = out.layer("triplets").unwrap();
     let t = StudentT::new(0.95).unwrap();
     let (mut n, mut inside, mut rel_sum) = (0usize, 0usize, 0.0);
     for i in 0..reference.len() {
@@ -233,12 +228,7 @@ subdivisions = 0
     assert!((ratio - 1.0).abs() < 5e-3, "image mean ratio {ratio}");
 
     // Per pixel: inside the Student-t interval widened by 3 of the path tracer's own SE.
-    let triplets = &out
-        .layers
-        .iter()
-        .find(|l| l.name == "triplets")
-        .unwrap()
-        .pixels;
+    let triplets = out.layer("triplets").unwrap();
     let t = StudentT::new(0.95).unwrap();
     let (mut n, mut inside) = (0usize, 0usize);
     for i in 0..out.subsurface.len() {
@@ -277,12 +267,7 @@ fn caps_are_reported_and_hold() {
         estimates
     );
     assert!(stat("pixels_triplet_cap") >= 0.9 * estimates);
-    let layer = &out
-        .layers
-        .iter()
-        .find(|l| l.name == "triplets")
-        .unwrap()
-        .pixels;
+    let layer = out.layer("triplets").unwrap();
     assert!(layer.iter().all(|p| p[0] <= 40.0), "cap held");
     assert!(stat("mean_triplets") <= 40.0 && stat("mean_triplets") >= 30.0);
     assert!(

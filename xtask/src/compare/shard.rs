@@ -46,6 +46,10 @@ const RUNS: &str = "runs.tsv";
 /// The scene facts.
 const SCENES: &str = "scenes.tsv";
 
+/// What a merge leaves out of a shard's directory besides its records: the shard's cache,
+/// and a report or results.csv of an earlier unsharded run there (the merge writes its own).
+const NOT_COPIED: [&str; 3] = ["cache", "report.md", "results.csv"];
+
 /// Files of a shard's directory that a merge reads instead of copying.
 const RECORDS: [&str; 5] = [
     MANIFEST,
@@ -306,18 +310,14 @@ pub fn run_shard(config: &Config, shard: Shard, log: &dyn Fn(&str)) -> Result<()
     let items = work(&plan, config.quick);
     let costs: Vec<f64> = items.iter().map(|(_, c)| *c).collect();
     let owner = assign(&costs, shard.count);
-    let mine: Vec<Work> = items
+    let (mine, load): (Vec<Work>, f64) = items
         .iter()
         .zip(&owner)
         .filter(|(_, s)| **s + 1 == shard.index)
-        .map(|((w, _), _)| *w)
-        .collect();
-    let load: f64 = costs
-        .iter()
-        .zip(&owner)
-        .filter(|(_, s)| **s + 1 == shard.index)
-        .map(|(c, _)| c)
-        .sum();
+        .fold((Vec::new(), 0.0), |(mut v, l), ((w, c), _)| {
+            v.push(*w);
+            (v, l + c)
+        });
     log(&format!(
         "shard {shard}: {} of {} items (estimated {:.0} % of the work) -> {}",
         mine.len(),
@@ -399,6 +399,17 @@ struct Manifest {
     /// The settings, in [`settings`]'s order.
     settings: Vec<(String, String)>,
     seconds: f64,
+}
+
+impl Manifest {
+    /// The value of setting `k` (empty when absent).
+    fn setting(&self, k: &str) -> String {
+        self.settings
+            .iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.clone())
+            .unwrap_or_default()
+    }
 }
 
 fn read_manifest(dir: &Path) -> Result<Manifest, Error> {
@@ -505,13 +516,7 @@ fn check_shards(manifests: &[Manifest]) -> Result<(), Error> {
 
 /// The settings of the run the shards made, as a config writing into `out`.
 fn merged_config(m: &Manifest, out: &Path) -> Result<Config, Error> {
-    let get = |k: &str| {
-        m.settings
-            .iter()
-            .find(|(key, _)| key == k)
-            .map(|(_, v)| v.clone())
-            .unwrap_or_default()
-    };
+    let get = |k: &str| m.setting(k);
     let bad = |k: &str| Error(format!("{}: bad `{k}`", m.dir.join(MANIFEST).display()));
     let list = |k: &str| -> Result<Vec<String>, Error> {
         let text = unescape(&get(k)).ok_or_else(|| bad(k))?;
@@ -540,10 +545,8 @@ fn copy_outputs(from: &Path, to: &Path, top: bool) -> Result<(), Error> {
         let name = entry.file_name();
         let name_str = name.to_string_lossy();
         let path = entry.path();
-        if top && (RECORDS.contains(&name_str.as_ref()) || name_str == "cache") {
-            continue;
-        }
-        if top && (name_str == "report.md" || name_str == "results.csv") {
+        if top && (RECORDS.contains(&name_str.as_ref()) || NOT_COPIED.contains(&name_str.as_ref()))
+        {
             continue;
         }
         let target = to.join(&name);
@@ -614,10 +617,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
         return Err(Error("--merge needs at least one shard directory".into()));
     }
     check_shards(&manifests)?;
-    let same = |a: &Path| {
-        let (a, b) = (a.canonicalize(), out.canonicalize());
-        matches!((a, b), (Ok(a), Ok(b)) if a == b)
-    };
+    let out_real = out.canonicalize().ok();
+    let same = |a: &Path| out_real.is_some() && a.canonicalize().ok() == out_real;
     if let Some(m) = manifests.iter().find(|m| same(&m.dir)) {
         return Err(Error(format!(
             "cannot merge into {}: it is shard {}'s own directory; give --out another one",
@@ -629,14 +630,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
     let presets = super::check(&config)?;
     std::fs::create_dir_all(out)
         .map_err(|e| Error(format!("cannot create {}: {e}", out.display())))?;
-    let setting = |k: &str| {
-        manifests[0]
-            .settings
-            .iter()
-            .find(|(key, _)| key == k)
-            .map(|(_, v)| v.clone())
-            .unwrap_or_default()
-    };
+    let setting = |k: &str| manifests[0].setting(k);
     let scene_names: Vec<String> = unescape(&setting("loaded"))
         .unwrap_or_default()
         .split(',')
@@ -821,10 +815,7 @@ mod tests {
             let name = e.file_name().to_string_lossy().to_string();
             let rel = prefix.join(&name);
             if prefix.as_os_str().is_empty()
-                && (name == "cache"
-                    || name == "report.md"
-                    || name == "results.csv"
-                    || RECORDS.contains(&name.as_str()))
+                && (NOT_COPIED.contains(&name.as_str()) || RECORDS.contains(&name.as_str()))
             {
                 continue;
             }
