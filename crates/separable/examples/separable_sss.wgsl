@@ -13,6 +13,14 @@
 //   weights change sign, as in SVD terms of rank >= 2, or under 1e-6 of the weight kept) the
 //   dropped weight takes the centre pixel's value instead.
 // - Background pixels (object id NO_OBJECT) output 0.
+// - Each pass writes its result times `params.out_scale` (per channel), plus the texel of
+//   `prev` when `params.accumulate` is not 0: the vertical pass of a multi-term kernel adds
+//   the terms up that way, and the rank-1 kernel's vertical pass divides by R with it.
+//
+// The intermediate and output images are rgba32float, so the passes keep f32 precision
+// between them as the CPU filter does; texels are read with textureLoad and blended in the
+// shader (no sampler), so the fractions are f32 too rather than a sampler's fixed point.
+// The crate `sss-gpu` runs this file through wgpu and checks it against the CPU filter.
 //
 // Not included: the per-pixel jitter (rotating the taps nearer the centre than a fraction of
 // the support by a hashed angle, which reads them bilinearly off-axis); without it this
@@ -22,10 +30,13 @@
 // `sss_separable::shader::constants(.., ShaderLanguage::Wgsl)`) between the two marker lines.
 // A rank-1 kernel (`preintegrated`, `svd1`, `artist`, `guided`, `gaussians1`) is one array,
 // `sssKernel`, applied in both passes; its weights sum to the total diffuse reflectance R, so
-// divide the vertical pass's output by R once (with `--normalize` they sum to 1 and the result
-// is multiplied by R or by an albedo instead). A multi-term kernel (`svd3`, `svd6`,
-// `gaussians6`) has arrays sssKernelH{i} and sssKernelV{i} per term i: point SSS_H and SSS_V
-// below at one term's arrays, build one pipeline per term, and add the terms' vertical outputs.
+// the vertical pass divides by R once: out_scale = 1 / R there, 1 in the horizontal pass (with
+// `--normalize` they sum to 1, and out_scale = R, or an albedo, in the vertical pass instead).
+// A multi-term kernel (`svd3`, `svd6`, `gaussians6`) has arrays sssKernelH{i} and
+// sssKernelV{i} per term i: point SSS_H and SSS_V below at one term's arrays, build one
+// pipeline per term, and add the terms' vertical outputs (accumulate = 1 from the second term
+// on, `prev` bound to the sum so far, `dst` to another texture). `sss_separable::shader::
+// wgsl_pass` does the pasting and the pointing.
 //
 // Bindings (group 0, the same layout for both passes):
 //   0 src           the pass's input: the irradiance (horizontal pass) or the horizontal
@@ -33,8 +44,10 @@
 //   1 depth         view-space distance to the surface, in mm
 //   2 object_id     the translucent object per pixel, NO_OBJECT for none
 //   3 mm_per_pixel  world-space size of one pixel at its surface, in mm
-//   4 dst           the pass's output
+//   4 dst           the pass's output (rgba32float)
 //   5 params        see `Params`
+//   6 prev          added to the result when params.accumulate is not 0 (the sum of the
+//                   previous terms' vertical passes); bind any other texture otherwise
 // Dispatch ceil(width / 8) × ceil(height / 8) workgroups per pass.
 
 // BEGIN sss kernel
@@ -66,15 +79,19 @@ struct Params {
     depth_threshold: f32,
     // Pixels whose kernel diameter is under this many pixels skip the blur (CPU default 1).
     min_footprint_px: f32,
-    _pad: f32,
+    // Not 0: add `prev` to the result.
+    accumulate: u32,
+    // The result is multiplied by out_scale.rgb (w unused).
+    out_scale: vec4<f32>,
 }
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var depth: texture_2d<f32>;
 @group(0) @binding(2) var object_id: texture_2d<u32>;
 @group(0) @binding(3) var mm_per_pixel: texture_2d<f32>;
-@group(0) @binding(4) var dst: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(4) var dst: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(5) var<uniform> params: Params;
+@group(0) @binding(6) var prev: texture_2d<f32>;
 
 // One pixel of one pass: its inputs and the running sums over the taps.
 struct Pass {
@@ -117,9 +134,10 @@ fn begin(pixel: vec2<i32>, axis: vec2<i32>) -> Pass {
     s.wmax = vec3<f32>(0.0);
     s.any_drop = false;
     // Sub-pixel skip: blur only where the kernel covers at least min_footprint_px pixels.
+    // (Background pixels read no taps either: they output 0.)
     let mmpp = textureLoad(mm_per_pixel, pixel, 0).r;
     s.inv_scale = 0.0;
-    if (mmpp > 0.0 && mmpp < 3.0e38) {
+    if (s.id != NO_OBJECT && mmpp > 0.0 && mmpp < 3.0e38) {
         let inv = 1.0 / mmpp;
         if (2.0 * params.support_mm * inv >= params.min_footprint_px && inv < 3.0e38) {
             s.inv_scale = inv;
@@ -182,6 +200,15 @@ fn finish(s: ptr<function, Pass>) -> vec3<f32> {
     return select(centre_filled, renormalised, valid);
 }
 
+// Writes a pass's result: scaled, plus the previous terms' sum when accumulating.
+fn store(pixel: vec2<i32>, result: vec3<f32>) {
+    var v = result * params.out_scale.rgb;
+    if (params.accumulate != 0u) {
+        v += textureLoad(prev, pixel, 0).rgb;
+    }
+    textureStore(dst, pixel, vec4<f32>(v, 1.0));
+}
+
 @compute @workgroup_size(8, 8)
 fn sss_horizontal(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixel = vec2<i32>(gid.xy);
@@ -192,7 +219,7 @@ fn sss_horizontal(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var i = 0u; i < SSS_H_TAPS; i++) {
         add_tap(&s, SSS_H[i]);
     }
-    textureStore(dst, pixel, vec4<f32>(finish(&s), 1.0));
+    store(pixel, finish(&s));
 }
 
 @compute @workgroup_size(8, 8)
@@ -205,5 +232,5 @@ fn sss_vertical(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var i = 0u; i < SSS_V_TAPS; i++) {
         add_tap(&s, SSS_V[i]);
     }
-    textureStore(dst, pixel, vec4<f32>(finish(&s), 1.0));
+    store(pixel, finish(&s));
 }

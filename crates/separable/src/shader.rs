@@ -37,6 +37,9 @@
 //! to the same f32; a non-finite value (or one that overflows f32) is an error, never `inf` or
 //! `NaN` in the text.
 //!
+//! [`wgsl_pass`] pastes the WGSL constants into the example compute pass, [`WGSL_PASS`] (the
+//! crate `sss-gpu` runs the result through wgpu and checks it against the CPU filter).
+//!
 //! ```
 //! use sss_bssrdf::{make_model, Medium, ModelKind};
 //! use sss_separable::shader::{self, ShaderLanguage, ShaderTaps};
@@ -221,6 +224,65 @@ pub fn constants(taps: &ShaderTaps, language: ShaderLanguage) -> Result<String, 
     Ok(out)
 }
 
+/// `examples/separable_sss.wgsl`: the separable pass as two WGSL compute entry points,
+/// `sss_horizontal` and `sss_vertical`, with the CPU filter's footprint, sub-pixel-skip and
+/// silhouette rules and no jitter ([`crate::screen_space`] with `jitter_radius` 0), holding a
+/// 3-tap placeholder kernel between the lines `// BEGIN sss kernel` and `// END sss kernel`.
+/// [`wgsl_pass`] pastes a kernel in.
+pub const WGSL_PASS: &str = include_str!("../examples/separable_sss.wgsl");
+
+const WGSL_BEGIN: &str = "// BEGIN sss kernel\n";
+const WGSL_END: &str = "// END sss kernel\n";
+
+/// [`WGSL_PASS`] with the WGSL constants of `taps` ([`constants`]) pasted between its marker
+/// lines and its horizontal and vertical taps (`SSS_H`, `SSS_V`) pointed at term `term`: the
+/// one array `sssKernel` of a rank-1 kernel (`term` must be 0), or `sssKernelH{term}` and
+/// `sssKernelV{term}`. The text is exactly what a user gets by pasting `sss kernel --format
+/// wgsl` into the example by hand. A multi-term kernel needs one module per term, whose
+/// vertical passes are summed (see the example's header for the bindings).
+pub fn wgsl_pass(taps: &ShaderTaps, term: usize) -> Result<String, SeparableError> {
+    let (h, v) = match taps {
+        ShaderTaps::Rank1(_) => {
+            ensure(term == 0, || {
+                format!("a rank-1 kernel has one term, not term {term}")
+            })?;
+            (RANK1_NAME.to_string(), RANK1_NAME.to_string())
+        }
+        ShaderTaps::Terms(t) => {
+            ensure(term < t.len(), || {
+                format!("the kernel has {} terms, not term {term}", t.len())
+            })?;
+            (
+                format!("{RANK1_NAME}H{term}"),
+                format!("{RANK1_NAME}V{term}"),
+            )
+        }
+    };
+    let constants = constants(taps, ShaderLanguage::Wgsl)?;
+    let markers = || SeparableError::InvalidArgument("the example pass lost its markers".into());
+    let (head, rest) = WGSL_PASS.split_once(WGSL_BEGIN).ok_or_else(markers)?;
+    let (_, tail) = rest.split_once(WGSL_END).ok_or_else(markers)?;
+    let mut tail = tail.to_string();
+    for (from, to) in [
+        (
+            "SSS_H_TAPS = sssKernelTaps;",
+            format!("SSS_H_TAPS = {h}Taps;"),
+        ),
+        ("SSS_H_TAPS> = sssKernel;", format!("SSS_H_TAPS> = {h};")),
+        (
+            "SSS_V_TAPS = sssKernelTaps;",
+            format!("SSS_V_TAPS = {v}Taps;"),
+        ),
+        ("SSS_V_TAPS> = sssKernel;", format!("SSS_V_TAPS> = {v};")),
+    ] {
+        ensure(tail.matches(from).count() == 1, || {
+            format!("the example pass lost the line `{from}`")
+        })?;
+        tail = tail.replacen(from, &to, 1);
+    }
+    Ok(format!("{head}{WGSL_BEGIN}{constants}{WGSL_END}{tail}"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -313,5 +375,41 @@ mod tests {
         );
         let text = constants(&t, ShaderLanguage::Wgsl).unwrap();
         assert_eq!(text.matches("const sssKernel").count(), 8);
+    }
+
+    /// `wgsl_pass` pastes the constants in place of the placeholder, points SSS_H / SSS_V at
+    /// the term asked for, and the result validates with naga; a term the kernel does not
+    /// have is an error.
+    #[test]
+    fn wgsl_pass_points_the_passes_at_one_term() {
+        let validate = |src: &str| {
+            let module = naga::front::wgsl::parse_str(src).unwrap();
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::default(),
+            )
+            .validate(&module)
+            .unwrap();
+        };
+        let k = SeparableKernel::symmetric(&three(), [0.5, 0.25, 0.125], 2.0).unwrap();
+        let rank1 = ShaderTaps::new(&k, [0.5, 0.25, 0.125], Energy::TotalReflectance);
+        let src = wgsl_pass(&rank1, 0).unwrap();
+        validate(&src);
+        assert!(src.contains(&constants(&rank1, ShaderLanguage::Wgsl).unwrap()));
+        assert!(!src.contains("A 3-tap placeholder"));
+        assert!(src.contains("const SSS_V: array<vec4<f32>, SSS_V_TAPS> = sssKernel;"));
+        assert!(wgsl_pass(&rank1, 1).is_err());
+
+        let mut two = k.clone();
+        two.terms.push(k.terms[0].clone());
+        let terms = ShaderTaps::new(&two, [1.0, 0.5, 0.25], Energy::TotalReflectance);
+        let src = wgsl_pass(&terms, 1).unwrap();
+        validate(&src);
+        assert!(src.contains("const SSS_H_TAPS = sssKernelH1Taps;"));
+        assert!(src.contains("const SSS_H: array<vec4<f32>, SSS_H_TAPS> = sssKernelH1;"));
+        assert!(src.contains("const SSS_V_TAPS = sssKernelV1Taps;"));
+        assert!(src.contains("const SSS_V: array<vec4<f32>, SSS_V_TAPS> = sssKernelV1;"));
+        assert!(wgsl_pass(&terms, 2).is_err());
+        validate(WGSL_PASS);
     }
 }

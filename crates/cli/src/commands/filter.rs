@@ -3,6 +3,11 @@
 //! `surface` (R = depth, G = world size of a pixel, both in scene units; B = object id + 1, 0
 //! where no translucent object is seen). Outputs the diffuse exitance E ∗ R_d per pixel (same
 //! unit as the irradiance; multiply by F_t(η, cos θ_o)/(cπ) for radiance).
+//!
+//! `--gpu` runs the same pass on a GPU through wgpu (`sss-gpu`: the WGSL shader that
+//! `sss kernel --format wgsl` pastes into, as two compute passes per term). It has no jitter,
+//! so it needs `--jitter 0`, and a build with the `gpu` feature; it gives the CPU's picture
+//! within f32 rounding. Without an adapter it stops with a one-line error.
 
 use crate::args::MediumArgs;
 use crate::commands::render::check_output;
@@ -43,6 +48,10 @@ pub struct FilterArgs {
     /// Tone-mapped PNG of the exitance.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
+    /// Run the pass on a GPU through wgpu (the exported WGSL compute shader). It has no
+    /// jitter: needs `--jitter 0`. Needs an `sss` built with the `gpu` feature.
+    #[arg(long)]
+    pub gpu: bool,
     /// Memory budget (bytes, or with a suffix: 512M, 8G); an input EXR whose header says it
     /// needs more to read is refused before any pixel is read. Default: half the physical
     /// memory.
@@ -58,6 +67,23 @@ pub fn run(args: &FilterArgs) -> Result<String, Error> {
             "--units-per-mm must be positive, got {}",
             args.units_per_mm
         )));
+    }
+    if args.gpu {
+        if !cfg!(feature = "gpu") {
+            return Err(no_gpu_feature());
+        }
+        if !settings.kernel.is_separable() {
+            return Err(Error::Input(format!(
+                "--gpu runs separable kernels only, not `{}`",
+                settings.kernel
+            )));
+        }
+        if settings.jitter != 0.0 {
+            return Err(Error::Input(format!(
+                "--gpu has no jitter: add --jitter 0 (got --jitter {})",
+                settings.jitter
+            )));
+        }
     }
     check_output(&args.out, "exr")?;
     if let Some(p) = &args.png {
@@ -101,8 +127,14 @@ pub fn run(args: &FilterArgs) -> Result<String, Error> {
         mm_per_pixel: &mm,
     };
     let opts = filter_options(&settings, args.seed);
+    let mut on = String::new();
     let t = std::time::Instant::now();
     let out = match &kernel {
+        MaterialKernel::Separable(k) if args.gpu => {
+            let (out, adapter) = gpu_filter(&input, k, &opts)?;
+            on = format!(" on {adapter}");
+            Ok(out)
+        }
         MaterialKernel::Separable(k) => screen_space::filter(&input, k, &opts),
         MaterialKernel::Full(k2) => convolve2d::exact(&input, k2, &opts),
     }
@@ -115,7 +147,45 @@ pub fn run(args: &FilterArgs) -> Result<String, Error> {
     }
     let covered = mask.iter().filter(|m| **m != NO_OBJECT).count();
     Ok(format!(
-        "filtered {w}x{h} ({covered} translucent pixels) with the {} kernel in {seconds:.4} s\n",
+        "filtered {w}x{h} ({covered} translucent pixels) with the {} kernel in {seconds:.4} s{on}\n",
         settings.kernel
     ))
+}
+
+/// The pass on the GPU: the output and the adapter's name. No adapter, or a GPU failure, is
+/// a one-line [`Error::Unsupported`].
+#[cfg(feature = "gpu")]
+fn gpu_filter(
+    input: &ScreenInput,
+    kernel: &sss_separable::SeparableKernel,
+    opts: &sss_separable::FilterOptions,
+) -> Result<(Vec<[f32; 3]>, String), Error> {
+    use sss_gpu::GpuError;
+    let fail = |e: GpuError| match e {
+        GpuError::Input(m) => Error::Input(format!("--gpu: {m}")),
+        e => Error::Unsupported(format!("--gpu: {e}")),
+    };
+    let gpu = sss_gpu::Gpu::new().map_err(fail)?;
+    let filter = sss_gpu::GpuFilter::new(&gpu, kernel, opts).map_err(fail)?;
+    let out = filter.filter(input).map_err(fail)?;
+    Ok((out, gpu.adapter_name()))
+}
+
+/// Without the `gpu` feature, `--gpu` is refused ([`run`] does so before reading the input).
+#[cfg(not(feature = "gpu"))]
+fn gpu_filter(
+    _: &ScreenInput,
+    _: &sss_separable::SeparableKernel,
+    _: &sss_separable::FilterOptions,
+) -> Result<(Vec<[f32; 3]>, String), Error> {
+    Err(no_gpu_feature())
+}
+
+/// The error of `--gpu` in a build without the `gpu` feature.
+fn no_gpu_feature() -> Error {
+    Error::Unsupported(
+        "--gpu: this sss was built without the `gpu` feature \
+         (build it with `cargo build --release -p sss-cli --features gpu`)"
+            .into(),
+    )
 }

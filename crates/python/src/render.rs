@@ -1,0 +1,290 @@
+//! `render()` (as `sss render`, into arrays), `diff()` (the figures of `sss diff`) and
+//! `read_exr()` (the EXR reader `sss diff` and `sss filter` use).
+
+use crate::arrays::{Axis, image, new_array, read};
+use crate::errors::{guard, to_py, value_error};
+use crate::progress::run_cancellable;
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use sss_bssrdf::Rgb;
+use sss_cli::commands::render::load_scene;
+use sss_render::Error;
+use sss_render::image::read_exr;
+use sss_render::integrators::{self, MethodOptions};
+use sss_render::metrics::{error_figures, mean_ratio_rgb};
+use sss_render::render::{RenderSettings, render as render_scene};
+use sss_render::scene::{LoadOptions, Scene, load_str};
+use std::path::PathBuf;
+
+/// Loads `scene`: TOML text (a str holding a line break), a path (str or os.PathLike) or the
+/// name of a built-in scene, as `sss render SCENE` resolves it.
+fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene> {
+    if let Ok(s) = scene.cast::<PyString>() {
+        let text = s.to_cow()?;
+        if text.contains('\n') {
+            let mut opts = LoadOptions::from_env();
+            let mut dirs = mesh_dirs.to_vec();
+            dirs.append(&mut opts.mesh_dirs);
+            opts.mesh_dirs = dirs;
+            let cwd = std::env::current_dir().ok();
+            return guard(|| {
+                load_str(&text, "scene.toml", cwd.as_deref(), &opts)
+                    .map_err(|e| to_py(Error::Scene(e)))
+            });
+        }
+        return guard(|| load_scene(&text, mesh_dirs).map_err(to_py));
+    }
+    let path: PathBuf = scene.extract().map_err(|_| {
+        PyTypeError::new_err(
+            "scene must be a path (str or os.PathLike), a built-in scene's name or TOML text",
+        )
+    })?;
+    let name = path.to_string_lossy().into_owned();
+    guard(|| load_scene(&name, mesh_dirs).map_err(to_py))
+}
+
+/// Method options from Python keyword arguments: `spp=4` is `--spp 4`, `uniform_taps=True`
+/// the switch `--uniform-taps` (False leaves it off).
+fn method_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<MethodOptions> {
+    let mut out = MethodOptions::new();
+    if let Some(d) = options {
+        for (key, value) in d.iter() {
+            let name = key.extract::<String>()?.replace('_', "-");
+            if let Ok(b) = value.cast::<pyo3::types::PyBool>() {
+                if b.is_true() {
+                    out.set(&name, "");
+                }
+                continue;
+            }
+            out.set(&name, value.str()?.to_cow()?);
+        }
+    }
+    Ok(out)
+}
+
+/// render(scene, method="exact", *, seed=1, threads=None, max_memory=None, mesh_dirs=None,
+/// progress=None, **options) -> dict
+///
+/// Renders `scene` (a path, a built-in scene's name, or TOML text) with `method` as
+/// `sss render` does; `options` are the method's options (`spp=16`, `kernel="svd3"`,
+/// `uniform_taps=True`). Returns a dict: the layers `total`, `subsurface`, `std_error`
+/// (stochastic methods) and the method's own (`irradiance`, `surface`, ...) as float32
+/// (H, W, 3); `coverage` float32 (H, W); `stats` {name: value}; `stages` {name: seconds};
+/// `method`, `settings` (the method's description), `irradiance_samples`, `warnings`.
+/// Releases the GIL; `progress(done, total)` is called with shaded samples; Ctrl-C stops it
+/// (KeyboardInterrupt), and so does an exception raised by `progress`.
+#[pyfunction]
+#[pyo3(signature = (scene, method="exact", *, seed=1, threads=None, max_memory=None, mesh_dirs=None, progress=None, **options))]
+#[allow(clippy::too_many_arguments)]
+pub fn render<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyAny>,
+    method: &str,
+    seed: u64,
+    threads: Option<usize>,
+    max_memory: Option<&Bound<'py, PyAny>>,
+    mesh_dirs: Option<Vec<PathBuf>>,
+    progress: Option<Bound<'py, PyAny>>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let opts = method_options(options)?;
+    let integrator = guard(|| integrators::build(method, &opts).map_err(to_py))?;
+    if threads == Some(0) {
+        return Err(value_error("threads must be at least 1"));
+    }
+    let max_memory = match max_memory {
+        None => sss_render::budget::default_budget(),
+        Some(v) => match v.extract::<u64>() {
+            Ok(n) => n,
+            Err(_) => {
+                let s: String = v.extract().map_err(|_| {
+                    PyTypeError::new_err("max_memory must be bytes (int) or a size like \"8G\"")
+                })?;
+                sss_render::budget::parse_bytes(&s)
+                    .map_err(|e| value_error(format!("max_memory: {e}")))?
+            }
+        },
+    };
+    let scene = scene_from(scene, &mesh_dirs.unwrap_or_default())?;
+    let settings = RenderSettings {
+        seed,
+        max_memory,
+        ..RenderSettings::default()
+    };
+    let pool = match threads {
+        Some(n) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| value_error(format!("cannot start {n} threads: {e}")))?,
+        ),
+        None => None,
+    };
+    let integrator_ref = integrator.as_ref();
+    let out = run_cancellable(py, crate::progress::callback(progress)?, |monitor| {
+        let go = || render_scene(&scene, integrator_ref, &settings, monitor);
+        match &pool {
+            Some(p) => p.install(go),
+            None => go(),
+        }
+    })?;
+    let warn = |msg: &str| -> PyResult<()> {
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        let text = std::ffi::CString::new(msg.replace('\0', " "))
+            .map_err(|e| value_error(e.to_string()))?;
+        PyErr::warn(py, &category, &text, 1)
+    };
+    let d = PyDict::new(py);
+    let (w, h) = (out.width, out.height);
+    d.set_item("total", image(py, &out.total, w, h)?)?;
+    d.set_item("subsurface", image(py, &out.subsurface, w, h)?)?;
+    if let Some(se) = &out.std_error {
+        d.set_item("std_error", image(py, se, w, h)?)?;
+    }
+    for layer in &out.layers {
+        d.set_item(layer.name, image(py, &layer.pixels, w, h)?)?;
+    }
+    let coverage: Vec<f32> = out
+        .coverage
+        .iter()
+        .map(|&c| if c.is_finite() { c } else { 0.0 })
+        .collect();
+    d.set_item(
+        "coverage",
+        new_array(py, coverage, &[h as usize, w as usize])?,
+    )?;
+    let stats = PyDict::new(py);
+    for s in &out.stats {
+        stats.set_item(s.name, s.value)?;
+    }
+    d.set_item("stats", stats)?;
+    let stages = PyDict::new(py);
+    for s in &out.stages {
+        stages.set_item(s.name, s.seconds)?;
+    }
+    d.set_item("stages", stages)?;
+    d.set_item("method", out.method)?;
+    d.set_item("settings", integrator.describe())?;
+    d.set_item("irradiance_samples", out.irradiance_samples)?;
+    let warnings: Vec<String> = scene
+        .warnings
+        .iter()
+        .chain(out.warnings.iter())
+        .cloned()
+        .collect();
+    for msg in &warnings {
+        warn(msg)?;
+    }
+    d.set_item("warnings", warnings)?;
+    Ok(d)
+}
+
+/// read_exr(path) -> dict[str, ndarray]
+///
+/// Every RGB layer of an OpenEXR file (as `sss render --out/--gbuffer` and `sss filter` write
+/// them), by name, as float32 (H, W, 3). Raises OSError for a file that cannot be read.
+#[pyfunction(name = "read_exr")]
+pub fn read_exr_layers<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let (w, h, layers) = py.detach(|| guard(|| read_exr(&path).map_err(to_py)))?;
+    let d = PyDict::new(py);
+    for (name, pixels) in &layers {
+        // Callers that look layers up by name take the first (as `sss diff`).
+        if !d.contains(name)? {
+            d.set_item(name, image(py, pixels, w, h)?)?;
+        }
+    }
+    Ok(d)
+}
+
+/// An image argument of `diff`: an array (H, W, 3) of float32 or float64, or an EXR path
+/// whose layer `layer` is taken.
+fn diff_input(
+    obj: &Bound<'_, PyAny>,
+    what: &str,
+    layer: &str,
+) -> PyResult<(usize, usize, Vec<Rgb>)> {
+    let rgb_pixels =
+        |v: Vec<f64>| -> Vec<Rgb> { v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect() };
+    let axes = [Axis::Any("H"), Axis::Any("W"), Axis::Fixed(3)];
+    if obj.cast::<numpy::PyUntypedArray>().is_ok() {
+        let (v, shape) = match read::<f64>(obj, what, "float64", &axes) {
+            Ok(got) => got,
+            Err(_) => {
+                let (v, shape) = read::<f32>(obj, what, "float32", &axes)?;
+                (v.into_iter().map(f64::from).collect(), shape)
+            }
+        };
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            return Err(value_error(format!(
+                "{what} holds a non-finite value ({}) at flat index {i}",
+                v[i]
+            )));
+        }
+        return Ok((shape[1], shape[0], rgb_pixels(v)));
+    }
+    let path: PathBuf = obj.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{what} must be an image array (H, W, 3) or the path of an EXR file"
+        ))
+    })?;
+    let (w, h, layers) = guard(|| read_exr(&path).map_err(to_py))?;
+    let pixels = layers
+        .iter()
+        .find(|(n, _)| n == layer)
+        .map(|(_, d)| d.clone())
+        .ok_or_else(|| {
+            let names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
+            value_error(format!(
+                "{}: no layer `{layer}` (it has: {})",
+                path.display(),
+                names.join(", ")
+            ))
+        })?;
+    Ok((w as usize, h as usize, pixels))
+}
+
+/// diff(a, ref, *, layer="subsurface", eps=0.05) -> dict
+///
+/// The error figures of `sss diff` of image `a` against `ref`: each an array (H, W, 3) of
+/// float32 or float64, or an EXR path (then `layer` is read). Pixels where either image is
+/// positive are compared. Returns {"pixels", "rmse", "rel_rmse", "frac_within_eps",
+/// "mean_ratio" (float64 (3,))}.
+#[pyfunction]
+#[pyo3(signature = (a, reference, *, layer="subsurface", eps=0.05))]
+pub fn diff<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    reference: &Bound<'py, PyAny>,
+    layer: &str,
+    eps: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !(eps.is_finite() && eps > 0.0) {
+        return Err(value_error(format!(
+            "eps must be a finite number > 0, got {eps}"
+        )));
+    }
+    let (w, h, img) = diff_input(a, "a", layer)?;
+    let (wr, hr, reference) = diff_input(reference, "ref", layer)?;
+    if (w, h) != (wr, hr) {
+        return Err(value_error(format!("a is {w}x{h} but ref is {wr}x{hr}")));
+    }
+    // The pixels `sss diff` compares: where either image is positive.
+    let pixels: Vec<usize> = (0..img.len())
+        .filter(|&i| reference[i].iter().chain(img[i].iter()).any(|v| *v > 0.0))
+        .collect();
+    let (f, ratio) = guard(|| {
+        Ok((
+            error_figures(&img, &reference, &pixels, eps),
+            mean_ratio_rgb(&img, &reference, &pixels),
+        ))
+    })?;
+    let clean = |v: f64| if v.is_finite() { v } else { 0.0 };
+    let d = PyDict::new(py);
+    d.set_item("pixels", pixels.len())?;
+    d.set_item("rmse", clean(f.rmse))?;
+    d.set_item("rel_rmse", clean(f.rel_rmse))?;
+    d.set_item("frac_within_eps", clean(f.frac_within_eps))?;
+    d.set_item("mean_ratio", crate::arrays::rgb(py, ratio.map(clean))?)?;
+    Ok(d)
+}

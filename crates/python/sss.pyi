@@ -1,0 +1,225 @@
+"""Subsurface scattering from Python: the toolkit's BSSRDF models, Monte Carlo reference,
+separable kernels, screen-space filter, renders and image metrics on numpy arrays.
+
+Profiles are float64, images float32 (H, W, 3) row-major from the top-left; lengths in mm.
+Errors keep the one-line message of the `sss` tool: ValueError for bad input, OSError for
+files, TypeError for an argument of the wrong type or dtype.
+"""
+
+import os
+from typing import Callable, Literal, Sequence, TypedDict, overload
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+#: Model names accepted by `Model` ("standard-dipole", "better-dipole", ...).
+MODELS: list[str]
+#: Kernel names accepted by `kernel` and `filter` ("preintegrated", "svd3", ..., "exact2d").
+KERNELS: list[str]
+#: Rendering methods accepted by `render` ("exact", "pathtrace", "separable", ...).
+METHODS: list[str]
+#: Names of the built-in scenes accepted by `render` ("sphere", ...).
+BUILTIN_SCENES: list[str]
+
+F64 = npt.NDArray[np.float64]
+F32 = npt.NDArray[np.float32]
+RGB = Sequence[float] | npt.ArrayLike
+#: progress(done, total), called on the calling thread about every 0.1 s and once at the end;
+#: raising from it stops the call and the exception propagates.
+ProgressCallback = Callable[[int, int], object]
+
+class Model:
+    """A BSSRDF model for a medium, as `sss profile` evaluates it.
+
+    `kind` is one of `MODELS`. The medium is a preset (see `presets()`; g = 0) or
+    `sigma_a` and `sigma_s` in 1/mm with anisotropy `g` (default 0); `eta` is the relative
+    index of refraction (default 1.3). Raises ValueError for an unknown model or preset or an
+    invalid medium.
+    """
+
+    def __init__(
+        self,
+        kind: str,
+        preset: str | None = None,
+        sigma_a: RGB | None = None,
+        sigma_s: RGB | None = None,
+        g: float | None = None,
+        eta: float | None = None,
+    ) -> None: ...
+    @property
+    def kind(self) -> str:
+        """The model's name."""
+    @property
+    def preset(self) -> str | None:
+        """The preset's name, or None for a medium given by coefficients."""
+    @property
+    def sigma_a(self) -> F64:
+        """Absorption coefficients (1/mm), shape (3,)."""
+    @property
+    def sigma_s(self) -> F64:
+        """Scattering coefficients (1/mm), shape (3,)."""
+    @property
+    def g(self) -> float:
+        """Henyey-Greenstein anisotropy."""
+    @property
+    def eta(self) -> float:
+        """Relative index of refraction."""
+    @property
+    def total_diffuse_reflectance(self) -> F64:
+        """Total diffuse reflectance per channel, shape (3,)."""
+    @overload
+    def rd(self, r: float) -> F64: ...
+    @overload
+    def rd(self, r: F64) -> F64: ...
+    def rd(self, r: float | F64) -> F64:
+        """R_d(r) in 1/mm² at radii r (mm, float64 (N,), finite, >= 0): shape (N, 3);
+        a float r gives shape (3,)."""
+    @overload
+    def sample_r(self, u: float, channel: int) -> float: ...
+    @overload
+    def sample_r(self, u: F64, channel: int) -> F64: ...
+    def sample_r(self, u: float | F64, channel: int) -> float | F64:
+        """Radii (mm) with density proportional to 2πr R_d(r) of `channel` (0, 1, 2), from
+        uniform u in [0, 1)."""
+    @overload
+    def pdf_r(self, r: float, channel: int) -> float: ...
+    @overload
+    def pdf_r(self, r: F64, channel: int) -> F64: ...
+    def pdf_r(self, r: float | F64, channel: int) -> float | F64:
+        """The density per mm of radius with which `sample_r` returns r."""
+
+class Preset(TypedDict):
+    sigma_s_reduced: F64
+    sigma_a: F64
+    eta: float
+    published_rd: F64
+
+def presets() -> dict[str, Preset]:
+    """The measured materials of Jensen et al. 2001 (Table 2), by name, as `sss presets`."""
+
+def monte_carlo(
+    *,
+    preset: str | None = None,
+    sigma_a: RGB | None = None,
+    sigma_s: RGB | None = None,
+    g: float | None = None,
+    eta: float | None = None,
+    r_max: float,
+    bins: int = 100,
+    photons: int = 1_000_000,
+    seed: int = 1,
+    progress: ProgressCallback | None = None,
+) -> tuple[F64, F64, F64]:
+    """The Monte Carlo reference of `sss profile --model monte-carlo`: bin centres (N,),
+    R_d (N, 3) and standard errors (N, 3) over `bins` linear bins of [0, r_max] mm.
+
+    Releases the GIL; progress counts photons (total 3 × photons); Ctrl-C raises
+    KeyboardInterrupt."""
+
+class Kernel:
+    """A separable screen-space kernel, exactly as `sss kernel` exports it."""
+
+    @property
+    def method(self) -> str: ...
+    @property
+    def model(self) -> str: ...
+    @property
+    def normalized(self) -> bool: ...
+    @property
+    def taps(self) -> F64 | None:
+        """Rank-1 kernels: (N, 4) rows (offset_mm, w_r, w_g, w_b) in the order of the CSV
+        export; None for multi-term kernels."""
+    @property
+    def terms(self) -> list[tuple[F64, F64]]:
+        """Per term, the (horizontal, vertical) taps, each (N, 4) as `taps`."""
+    def export(self, format: Literal["json", "csv", "glsl", "hlsl", "wgsl"] = "json") -> str:
+        """The text `sss kernel --format FORMAT` prints."""
+
+def kernel(
+    model: Model,
+    method: str = "preintegrated",
+    *,
+    taps: int = 7,
+    uniform: bool = False,
+    k: float = 2.0,
+    artist_preset: str | None = None,
+    normalize: bool = False,
+) -> Kernel:
+    """The separable kernel of `model` (`method` one of `KERNELS` but "exact2d")."""
+
+def filter(
+    irradiance: F32,
+    depth: F32,
+    footprint: F32,
+    object_id: npt.NDArray[np.int32],
+    kernel: str | Kernel | None = None,
+    model: Model | None = None,
+    *,
+    units_per_mm: float = 1.0,
+    taps: int | None = None,
+    uniform_taps: bool | None = None,
+    k: float | None = None,
+    jitter: float | None = None,
+    seed: int = 1,
+) -> F32:
+    """The screen-space separable pass of `sss filter` on arrays.
+
+    irradiance float32 (H, W, 3); depth and footprint (world size of a pixel) float32 (H, W)
+    in scene units; object_id int32 (H, W), negative where no translucent object is seen.
+    `kernel` is a name from `KERNELS` (None: "preintegrated"; with `model`) or a `Kernel`
+    (its model, method and taps). Returns the diffuse
+    exitance E ∗ R_d, float32 (H, W, 3). Releases the GIL."""
+
+class RenderResult(TypedDict, total=False):
+    total: F32
+    subsurface: F32
+    std_error: F32
+    irradiance: F32
+    surface: F32
+    coverage: F32
+    stats: dict[str, float]
+    stages: dict[str, float]
+    method: str
+    settings: str
+    irradiance_samples: int
+    warnings: list[str]
+
+def render(
+    scene: str | os.PathLike[str],
+    method: str = "exact",
+    *,
+    seed: int = 1,
+    threads: int | None = None,
+    max_memory: int | str | None = None,
+    mesh_dirs: Sequence[str | os.PathLike[str]] | None = None,
+    progress: ProgressCallback | None = None,
+    **options: str | int | float | bool,
+) -> RenderResult:
+    """Render `scene` (a path, a name from `BUILTIN_SCENES`, or TOML text holding a line
+    break) with `method` (one of `METHODS`) as `sss render` does; `options` are the method's
+    options (`spp=16`, `kernel="svd3"`, `uniform_taps=True`).
+
+    Returns the layers (`total`, `subsurface`, `std_error` for stochastic methods, the
+    method's own) as float32 (H, W, 3), `coverage` (H, W), `stats`, `stages` (seconds),
+    `method`, `settings`, `irradiance_samples`, `warnings`. Releases the GIL; progress counts
+    shaded samples; Ctrl-C raises KeyboardInterrupt; an exception from progress stops it."""
+
+def read_exr(path: str | os.PathLike[str]) -> dict[str, F32]:
+    """Every RGB layer of an OpenEXR file by name, float32 (H, W, 3)."""
+
+class DiffResult(TypedDict):
+    pixels: int
+    rmse: float
+    rel_rmse: float
+    frac_within_eps: float
+    mean_ratio: F64
+
+def diff(
+    a: F32 | F64 | str | os.PathLike[str],
+    reference: F32 | F64 | str | os.PathLike[str],
+    *,
+    layer: str = "subsurface",
+    eps: float = 0.05,
+) -> DiffResult:
+    """The figures of `sss diff`: images (H, W, 3) or EXR paths (their `layer`)."""
