@@ -50,8 +50,12 @@ use crate::shading_cluster::ShadingPoint;
 pub struct IrradiancePoint {
     /// Position on the surface.
     pub position: DVec3,
-    /// Unit geometric normal of the surface there (outward).
+    /// Unit shading normal there (outward; the mesh's interpolated normal): cos θ_i is taken
+    /// against it, as `manylight`, `exact` and `pathtrace` take it.
     pub normal: DVec3,
+    /// Unit geometric normal of the triangle there (outward): a light below its plane cannot
+    /// reach the point, whatever the shading normal (zero: no such test).
+    pub geometric: DVec3,
     /// Area weight A_k = 1/(N p(x_k | x_o)) (length²): the point's share of the surface in
     /// an N-point estimate.
     pub area: f64,
@@ -63,8 +67,10 @@ pub struct IrradiancePoint {
 pub struct GatherPoint {
     /// Position x_k.
     pub position: DVec3,
-    /// Unit geometric normal at x_k.
+    /// Unit shading normal at x_k (see [`IrradiancePoint::normal`]).
     pub normal: DVec3,
+    /// Unit geometric normal at x_k (see [`IrradiancePoint::geometric`]).
+    pub geometric: DVec3,
     /// RGB strength, each ≥ 0 (the units of w · R_d · A).
     pub strength: [f64; 3],
 }
@@ -97,6 +103,7 @@ pub fn gather_points(
             out.push(GatherPoint {
                 position: p.position,
                 normal: p.normal,
+                geometric: p.geometric,
                 strength,
             });
         }
@@ -122,6 +129,7 @@ pub fn uniform_points(
         out.push(IrradiancePoint {
             position: at.position,
             normal: at.normal,
+            geometric: at.geometric,
             area,
         });
     }
@@ -174,14 +182,16 @@ impl GatherTree {
             )));
         }
         for (k, p) in points.iter().enumerate() {
-            let ok_n = p.normal == DVec3::ZERO
-                || (p.normal.is_finite() && (p.normal.length() - 1.0).abs() < 1e-6);
+            let unit_or_zero =
+                |n: DVec3| n == DVec3::ZERO || (n.is_finite() && (n.length() - 1.0).abs() < 1e-6);
+            let ok_n = unit_or_zero(p.normal) && unit_or_zero(p.geometric);
             let ok_s = p.strength.iter().all(|v| v.is_finite() && *v >= 0.0) && p.scalar() > 0.0;
             if !(p.position.is_finite() && ok_n && ok_s) {
                 return Err(Error::InvalidInput(format!(
-                    "gather point {k}: position {:?}, normal {:?}, strength {:?} (need finite \
-                     position, unit or zero normal, finite strength ≥ 0 with luminance > 0)",
-                    p.position, p.normal, p.strength
+                    "gather point {k}: position {:?}, normals {:?} and {:?}, strength {:?} (need \
+                     finite position, unit or zero normals, finite strength ≥ 0 with luminance > \
+                     0)",
+                    p.position, p.normal, p.geometric, p.strength
                 )));
             }
         }

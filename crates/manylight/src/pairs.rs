@@ -14,15 +14,19 @@
 //! here because it is folded exactly into each gather point's strength
 //! ([`crate::gather_tree`]).
 
+use glam::DVec3;
+
 use crate::bounds;
 use crate::estimator::{GRAZING_COS, Visibility};
 use crate::gather_tree::{GatherNode, GatherPoint};
 use crate::profile::Transmittance;
 use crate::vpl::{LightNode, Vpl};
 
-/// H(y, x) for a VPL and a gather point, and whether G was clamped. 0 when the point faces
-/// away (or sees the light edge-on: cos θ_i ≤ [`GRAZING_COS`]), the VPL emits away from it,
-/// they coincide, or the visibility test fails (only called when H would be > 0).
+/// H(y, x) for a VPL and a gather point, and whether G was clamped. 0 when the point's
+/// shading normal faces away (or sees the light edge-on: cos θ_i ≤ [`GRAZING_COS`]), the light
+/// is not above the triangle's own plane (its geometric normal, as the estimator and the
+/// renderer's shadow rays), the VPL emits away from it, they coincide, or the visibility test
+/// fails (only called when H would be > 0).
 pub(crate) fn transfer(
     vpl: &Vpl,
     x: &GatherPoint,
@@ -39,7 +43,8 @@ pub(crate) fn transfer(
     let dir = to_light / d;
     let cos_i = x.normal.dot(dir);
     let cos_y = vpl.emission_cos(-dir);
-    if !(cos_i > GRAZING_COS && cos_y > 0.0) {
+    let above = x.geometric == DVec3::ZERO || x.geometric.dot(dir) > GRAZING_COS;
+    if !(cos_i > GRAZING_COS && cos_y > 0.0 && above) {
         return (0.0, false);
     }
     let clamped = d2 < 1.0 / g_max;
@@ -125,4 +130,41 @@ pub(crate) fn validate_settings(
         return bad(format!("max_pairs = {max_pairs} must be in 1..=2^30"));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A gather point whose shading normal leans towards a light that is below its triangle's
+    /// own plane gets no light from it (a shadow ray cannot leave a flat triangle on its back
+    /// side); the same light a little above the plane lights it, through the shading normal's
+    /// cosine.
+    #[test]
+    fn a_light_below_the_triangle_plane_transfers_nothing() {
+        let lean = DVec3::new(0.6, 0.0, 0.8);
+        let x = GatherPoint {
+            position: DVec3::ZERO,
+            normal: lean,
+            geometric: DVec3::Z,
+            strength: [1.0; 3],
+        };
+        let ft = Transmittance::one();
+        let open = |_: DVec3, _: DVec3| true;
+        let below = Vpl::point(DVec3::new(1.0, 0.0, -0.1), [1.0; 3]);
+        let above = Vpl::point(DVec3::new(1.0, 0.0, 0.1), [1.0; 3]);
+        // The shading normal faces both lights.
+        assert!(lean.dot(below.position.normalize()) > 0.5);
+        assert_eq!(transfer(&below, &x, &ft, 1e6, &open).0, 0.0);
+        let (h, _) = transfer(&above, &x, &ft, 1e6, &open);
+        let d = above.position;
+        let want = lean.dot(d.normalize()) / d.length_squared();
+        assert!((h - want).abs() < 1e-12 * want, "{h} vs {want}");
+        // Without a geometric normal there is no plane test.
+        let free = GatherPoint {
+            geometric: DVec3::ZERO,
+            ..x
+        };
+        assert!(transfer(&below, &free, &ft, 1e6, &open).0 > 0.0);
+    }
 }

@@ -105,6 +105,7 @@ fn importance_gather(s: &Scene, n: usize, seed: u64) -> Vec<GatherPoint> {
                 pts.push(IrradiancePoint {
                     position: x,
                     normal,
+                    geometric: normal,
                     area: 1.0 / (n as f64 * q_plane(x)),
                 });
             } else {
@@ -115,6 +116,7 @@ fn importance_gather(s: &Scene, n: usize, seed: u64) -> Vec<GatherPoint> {
                     pts.push(IrradiancePoint {
                         position: x,
                         normal: DVec3::Z,
+                        geometric: DVec3::Z,
                         area: 1.0 / (n as f64 * q_plane(x)),
                     });
                 }
@@ -441,6 +443,7 @@ fn shadowed_and_black_pixels_terminate() {
     let pts = [IrradiancePoint {
         position: DVec3::new(0.5, 0.5, 0.0),
         normal: DVec3::Z,
+        geometric: DVec3::Z,
         area: 1.0,
     }];
     gather_points(&zero, &pts, &s.profile, &mut none);
@@ -492,6 +495,7 @@ fn bad_inputs_are_errors() {
     let p = GatherPoint {
         position: DVec3::ZERO,
         normal: DVec3::Z,
+        geometric: DVec3::Z,
         strength: [1.0; 3],
     };
     for bad in [
@@ -509,6 +513,10 @@ fn bad_inputs_are_errors() {
         },
         GatherPoint {
             normal: DVec3::new(0.0, 0.0, 2.0),
+            ..p
+        },
+        GatherPoint {
+            geometric: DVec3::new(0.0, 3.0, 0.0),
             ..p
         },
     ] {

@@ -22,8 +22,8 @@
 //!   ([`sss_manylight::uniform_points`]): unbiased, but few points land where R_d is large.
 //!
 //! The irradiance at x_k comes from the VPLs through the same H = cos θ_i cos θ_y
-//! min(1/d², G_max) V F_t(cos θ_i) as `manylight`, with the triangle's geometric normal and the
-//! same clamp G_max ([`sss_manylight::Settings::g_max_for_scene`]). So Σ_{x_o} w Σ_k A_k R_d
+//! min(1/d², G_max) V F_t(cos θ_i) as `manylight`: cos θ_i against the mesh's interpolated
+//! shading normal, the light above the triangle's own plane, and the same clamp G_max ([`sss_manylight::Settings::g_max_for_scene`]). So Σ_{x_o} w Σ_k A_k R_d
 //! Σ_y I H — the point set's value — is an unbiased estimate of the pixel value `manylight`
 //! estimates, and EELC estimates the point set's value without bias at a fixed stratum count;
 //! MDLC's representatives are biased at a finite cut (see [`sss_manylight::mdlc`]). The pixel
@@ -390,7 +390,8 @@ fn estimate_pixels<E: PixelEstimator>(
                                     {
                                         points.push(IrradiancePoint {
                                             position: hit.p,
-                                            normal: hit.ng,
+                                            normal: hit.n,
+                                            geometric: hit.ng,
                                             area: a / pdf,
                                         });
                                     }
