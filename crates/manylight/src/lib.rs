@@ -54,6 +54,9 @@
 //! triangles' normals were used for cos θ_i where the renderer's other methods use the mesh's
 //! interpolated shading normals, which put the image mean 1 % low on a scanned dragon and
 //! 7.6 % high on an icosahedron; see [`irradiance_cluster`] for the measurement and the fix.
+//! The baselines' irradiance points had the same flaw (their importance-sampled points carried
+//! the triangle's flat normal: EELC 7.5 % high on the icosahedron, 0–2.7 % low on the compare
+//! scenes below); an [`IrradiancePoint`] now carries both normals, as a [`SurfaceSample`] does.
 //! `cargo xtask compare --manylight` now scores the method against a path-traced reference
 //! (BSSRDF importance sampling with probe rays and continuous light sampling: no VPLs,
 //! clusters or bounds) on seven scenes: the paper's three (a Buddha, two Buddhas, a head;

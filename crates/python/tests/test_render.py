@@ -135,7 +135,10 @@ def test_a_raising_callback_stops_the_render_and_the_next_render_is_right(small_
 
 def test_ctrl_c_raises_keyboard_interrupt_during_a_render():
     # SIGINT arrives while the render runs with the GIL released; the main thread must notice
-    # it within a poll, not when the render ends.
+    # it within a poll, not when the render ends. Python's own handler is installed first: a
+    # process started in the background by a non-interactive shell inherits SIGINT ignored,
+    # and Python then leaves it ignored (no KeyboardInterrupt at all).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
     t = time.perf_counter()
     timer.start()
@@ -144,6 +147,7 @@ def test_ctrl_c_raises_keyboard_interrupt_during_a_render():
             sss.render(LONG["scene"], LONG["method"], spp=4 * LONG["spp"])
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     assert time.perf_counter() - t < 3.0
 
 
