@@ -154,8 +154,11 @@ def test_ctrl_c_raises_keyboard_interrupt_during_a_render():
 def test_long_calls_release_the_gil():
     # A Python thread keeps ticking (every millisecond) while the render and the Monte Carlo
     # walk run: with the GIL held for the whole call it could not tick until the call returned.
+    # Each call is repeated until half a second has passed, so that a fast machine still gives
+    # a long enough window (between calls the GIL is free anyway, but only for microseconds:
+    # a call that held it would leave about one tick per call).
     for call in [
-        lambda: sss.render(LONG["scene"], LONG["method"], spp=16),
+        lambda: sss.render(LONG["scene"], LONG["method"], spp=LONG["spp"]),
         lambda: sss.monte_carlo(preset="skin1", r_max=4.0, bins=20, photons=500_000),
     ]:
         ticks = []
@@ -171,13 +174,17 @@ def test_long_calls_release_the_gil():
         while not ticks:
             time.sleep(0.001)
         start = time.perf_counter()
+        calls = 0
         try:
-            call()
+            while calls == 0 or time.perf_counter() - start < 0.5:
+                call()
+                calls += 1
         finally:
             end = time.perf_counter()
             stop.set()
             t.join()
         assert end - start > 0.3, "the call is too short to tell"
+        assert calls < 50, calls
         during = [x for x in ticks if start < x < end]
         # About one tick per millisecond when the thread can run; demand a tenth of that.
         assert len(during) > 100 * (end - start), (len(during), end - start)
