@@ -17,64 +17,14 @@
 //! `cargo bench -p sss-bench --bench gpu -- --noplot`; `WGPU_BACKEND=vulkan|gl` picks a backend.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use sss_bench::Frame;
 use sss_bssrdf::{Medium, ModelKind, make_model};
 use sss_gpu::{Gpu, GpuFilter};
 use sss_separable::screen_space::{self, FilterOptions};
 use sss_separable::{
-    Kernel2d, Kernel2dSpec, ScreenInput, SeparableKernel, TapPlacement, gaussians, preintegrated,
+    Kernel2d, Kernel2dSpec, SeparableKernel, TapPlacement, gaussians, preintegrated,
 };
 use std::time::{Duration, Instant};
-
-struct Frame {
-    width: usize,
-    height: usize,
-    irradiance: Vec<[f32; 3]>,
-    depth: Vec<f32>,
-    mask: Vec<u32>,
-    mm_per_pixel: Vec<f32>,
-}
-
-impl Frame {
-    /// The `1080p` frame of `benches/separable.rs`.
-    fn new(width: usize, height: usize) -> Frame {
-        let n = width * height;
-        let u = sss_bench::uniforms(n, 11);
-        Frame {
-            width,
-            height,
-            irradiance: u
-                .iter()
-                .map(|v| if *v < 0.1 { [0.1; 3] } else { [1.0, 0.9, 0.8] })
-                .collect(),
-            depth: (0..n).map(|i| 600.0 + (i % width) as f32 * 0.05).collect(),
-            mask: vec![0; n],
-            mm_per_pixel: vec![0.5; n],
-        }
-    }
-
-    /// The `1080p-tilted` frame: the footprint grows across the frame.
-    fn tilted(width: usize, height: usize) -> Frame {
-        let mut f = Frame::new(width, height);
-        let (wf, hf) = (width.max(2) as f32 - 1.0, height.max(2) as f32 - 1.0);
-        for (i, (d, m)) in f.depth.iter_mut().zip(&mut f.mm_per_pixel).enumerate() {
-            let (x, y) = ((i % width) as f32, (i / width) as f32);
-            *m = 0.3 + 0.4 * x / wf + 0.05 * y / hf;
-            *d = 600.0 + 0.1 * x + 0.05 * y;
-        }
-        f
-    }
-
-    fn input(&self) -> ScreenInput<'_> {
-        ScreenInput {
-            width: self.width,
-            height: self.height,
-            irradiance: &self.irradiance,
-            depth: &self.depth,
-            mask: &self.mask,
-            mm_per_pixel: &self.mm_per_pixel,
-        }
-    }
-}
 
 /// The largest |gpu − cpu| relative to the frame's largest value.
 fn largest_difference(cpu: &[[f32; 3]], gpu: &[[f32; 3]]) -> f32 {

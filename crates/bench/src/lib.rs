@@ -45,6 +45,68 @@ pub fn uniforms(n: usize, seed: u64) -> Vec<f64> {
     (0..n).map(|_| rng.random::<f64>()).collect()
 }
 
+/// A screen-space filter frame of the benchmarks (`benches/separable.rs`, `benches/gpu.rs`):
+/// the irradiance, depth (mm), object ids and footprint (mm per pixel) of every pixel.
+pub struct Frame {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Irradiance per pixel.
+    pub irradiance: Vec<[f32; 3]>,
+    /// Depth per pixel (mm).
+    pub depth: Vec<f32>,
+    /// Object id per pixel (all 0: one object).
+    pub mask: Vec<u32>,
+    /// Footprint per pixel (mm).
+    pub mm_per_pixel: Vec<f32>,
+}
+
+impl Frame {
+    /// The `1080p` frame at its size: a random two-level texture (10 % dark) at 0.5 mm per
+    /// pixel, depth growing slowly across the frame (under the rejection threshold).
+    pub fn new(width: usize, height: usize) -> Frame {
+        let n = width * height;
+        let u = uniforms(n, 11);
+        Frame {
+            width,
+            height,
+            irradiance: u
+                .iter()
+                .map(|v| if *v < 0.1 { [0.1; 3] } else { [1.0, 0.9, 0.8] })
+                .collect(),
+            depth: (0..n).map(|i| 600.0 + (i % width) as f32 * 0.05).collect(),
+            mask: vec![0; n],
+            mm_per_pixel: vec![0.5; n],
+        }
+    }
+
+    /// The `1080p-tilted` frame: the same texture on a surface whose footprint grows across
+    /// the frame (0.3 to 0.75 mm per pixel), so every pixel's taps differ from its neighbours'.
+    pub fn tilted(width: usize, height: usize) -> Frame {
+        let mut f = Frame::new(width, height);
+        let (wf, hf) = (width.max(2) as f32 - 1.0, height.max(2) as f32 - 1.0);
+        for (i, (d, m)) in f.depth.iter_mut().zip(&mut f.mm_per_pixel).enumerate() {
+            let (x, y) = ((i % width) as f32, (i / width) as f32);
+            *m = 0.3 + 0.4 * x / wf + 0.05 * y / hf;
+            *d = 600.0 + 0.1 * x + 0.05 * y;
+        }
+        f
+    }
+
+    /// The frame as the filter's input.
+    pub fn input(&self) -> sss_separable::ScreenInput<'_> {
+        sss_separable::ScreenInput {
+            width: self.width,
+            height: self.height,
+            irradiance: &self.irradiance,
+            depth: &self.depth,
+            mask: &self.mask,
+            mm_per_pixel: &self.mm_per_pixel,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -79,12 +79,11 @@ impl Reference {
     }
 }
 
-/// Sums of one work item's paths: per channel Σv and Σv², and the luminance's.
+/// Sums of one work item's paths: per channel Σv, and the luminance's Σ and Σ².
 #[derive(Clone, Copy, Default)]
 struct Sums {
     n: u64,
     s: [f64; 3],
-    s2: [f64; 3],
     l: f64,
     l2: f64,
 }
@@ -94,7 +93,6 @@ impl Sums {
         self.n += o.n;
         for c in 0..3 {
             self.s[c] += o.s[c];
-            self.s2[c] += o.s2[c];
         }
         self.l += o.l;
         self.l2 += o.l2;
@@ -105,18 +103,14 @@ impl Sums {
         self.s.map(|s| s / n)
     }
 
-    /// Variance of the mean of channel values (`None`: the luminance).
-    fn var_of_mean(&self, channel: Option<usize>) -> f64 {
+    /// Variance of the mean of the luminance.
+    fn var_of_mean(&self) -> f64 {
         if self.n < 2 {
             return 0.0;
         }
         let n = self.n as f64;
-        let (s, s2) = match channel {
-            Some(c) => (self.s[c], self.s2[c]),
-            None => (self.l, self.l2),
-        };
-        let m = s / n;
-        ((s2 - n * m * m) / (n - 1.0)).max(0.0) / n
+        let m = self.l / n;
+        ((self.l2 - n * m * m) / (n - 1.0)).max(0.0) / n
     }
 }
 
@@ -147,9 +141,8 @@ fn trace(
     };
     for _ in 0..n {
         let v = sampler.sample(g, &mut r, &mut scratch);
-        for ((s, s2), x) in out.s.iter_mut().zip(&mut out.s2).zip(v) {
+        for (s, x) in out.s.iter_mut().zip(v) {
             *s += x;
-            *s2 += x * x;
         }
         let l = lum(v);
         out.l += l;
@@ -252,7 +245,7 @@ pub fn path_reference(
                 .iter()
                 .map(|&i| pilot[i].l / pilot[i].n.max(1) as f64)
                 .sum();
-            let v: f64 = ss.iter().map(|&i| pilot[i].var_of_mean(None)).sum();
+            let v: f64 = ss.iter().map(|&i| pilot[i].var_of_mean()).sum();
             let noisy = l.is_nan() || l <= 0.0 || v.sqrt() / l > PILOT_REL_SE;
             noisy && spent * (ss.len() as u64) * 8 <= budget.max_paths
         });
@@ -272,7 +265,7 @@ pub fn path_reference(
                 / k;
             let v: f64 = ss
                 .iter()
-                .map(|&i| pilot[i].var_of_mean(None) * pilot[i].n as f64)
+                .map(|&i| pilot[i].var_of_mean() * pilot[i].n as f64)
                 .sum();
             let cap = (budget.max_paths / ss.len() as u64).max(budget.pilot);
             let n0 = ss
@@ -328,7 +321,7 @@ pub fn path_reference(
             for c in 0..3 {
                 v[c] += m[c] / k;
             }
-            lvar += sums[i].var_of_mean(None) / (k * k);
+            lvar += sums[i].var_of_mean() / (k * k);
         }
         let l = lum(v);
         values.push(v);
