@@ -232,6 +232,38 @@ impl Channel {
         }
     }
 
+    /// (R, R′, R″) in closed form: with t = r/d, K = A/(8π d²) and
+    /// f(t) = (e^{−t} + e^{−t/3})/t, R = K f(t), R′ = K f′(t)/d, R″ = K f″(t)/d², where
+    /// f′ = −(e^{−t} + e^{−t/3}/3)/t − (e^{−t} + e^{−t/3})/t² and
+    /// f″ = (e^{−t} + e^{−t/3}/9)/t + 2(e^{−t} + e^{−t/3}/3)/t² + 2(e^{−t} + e^{−t/3})/t³
+    /// (memo Eq. 2-3 differentiated). Below t = [`R0_FRACTION`], where `rd` is held constant,
+    /// both derivatives are 0.
+    fn derivatives(&self, r: f64) -> (f64, f64, f64) {
+        if !(self.a > 0.0) || !(r >= 0.0) {
+            return (0.0, 0.0, 0.0);
+        }
+        let d = self.d;
+        let t = r / d;
+        if !t.is_finite() {
+            return (0.0, 0.0, 0.0);
+        }
+        let v = self.rd(r);
+        if t < R0_FRACTION {
+            return (v, 0.0, 0.0);
+        }
+        let k = self.a / (8.0 * PI * d) / d;
+        let e1 = (-t).exp();
+        let e3 = (-t / 3.0).exp();
+        let (s0, s1, s2) = (e1 + e3, e1 + e3 / 3.0, e1 + e3 / 9.0);
+        let f1 = -(s1 + s0 / t) / t;
+        let f2 = (s2 + (2.0 * s1 + 2.0 * s0 / t) / t) / t;
+        (
+            v,
+            crate::finite_or_zero(k * f1 / d),
+            crate::finite_or_zero(k * f2 / (d * d)),
+        )
+    }
+
     fn pdf(&self, r: f64) -> f64 {
         if !(r >= 0.0) || !r.is_finite() {
             return 0.0;
@@ -330,6 +362,9 @@ impl Bssrdf for ChristensenBurley {
     }
     fn rd(&self, ch: usize, r: f64) -> f64 {
         self.ch[ch].rd(r.abs())
+    }
+    fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {
+        self.ch[ch].derivatives(r.abs())
     }
     fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
         self.ch[ch].a

@@ -125,6 +125,29 @@ pub trait Bssrdf: Send + Sync {
     /// the profile may be culled.
     fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64;
 
+    /// R_d(r) with its first two radial derivatives, (R_d, dR_d/dr, d²R_d/dr²) in 1/mm²,
+    /// 1/mm³ and 1/mm⁴, for r ≥ 0 (negative r is read as |r|). Finite everywhere, r = 0
+    /// included (where the closed forms, even in r, give dR_d/dr = 0; a tabulated spline
+    /// need not be flat there); where a model clamps R_d
+    /// (to 0, or to a constant near r = 0) the derivatives are those of the clamped function.
+    /// The value is [`Bssrdf::rd`]'s to rounding. Used by local expansions of R_d (Taylor
+    /// series of R_d(‖x − p‖) about a point: value, gradient R_d′ u, Hessian
+    /// R_d″ uuᵀ + (R_d′/r)(I − uuᵀ)).
+    ///
+    /// The standard and better dipole and Christensen–Burley override it with closed forms
+    /// (the derivatives of their formulas, see each module), photon beam diffusion and
+    /// `mc-table` with the derivatives of their Catmull-Rom spline
+    /// ([`spline_row::SplineRow::eval_over_x_derivatives`]). This default is only a fallback
+    /// (the directional dipole's radial part): central differences of [`Bssrdf::rd`]
+    /// ([`rd_derivatives_by_differences`]).
+    fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {
+        rd_derivatives_by_differences(
+            |x| self.rd(ch, x),
+            r,
+            self.medium().reduced_mean_free_path(ch),
+        )
+    }
+
     /// R_d(r) for the three channels.
     fn rd_rgb(&self, r: f64) -> Rgb {
         [self.rd(0, r), self.rd(1, r), self.rd(2, r)]
@@ -158,6 +181,41 @@ pub fn separable_s(medium: &Medium, sp: Rgb, cos_i: f64, cos_o: f64) -> Rgb {
     let w = fresnel::ft_dielectric(cos_i, eta) * fresnel::ft_dielectric(cos_o, eta)
         / (c * std::f64::consts::PI);
     [sp[0] * w, sp[1] * w, sp[2] * w]
+}
+
+/// (f(r), f′(r), f″(r)) of an even radial profile f by central differences with step
+/// h = 10⁻³ max(|r|, 10⁻² ℓ) (ℓ > 0 a length scale of the profile, 1 if it is not finite and
+/// positive), evaluating f at |r ± h| (so r = 0 gives f′ = 0). Truncation and rounding
+/// errors are near 10⁻⁷ and 10⁻¹⁰ relative for profiles smooth on the scale of r; the fallback of
+/// [`Bssrdf::rd_derivatives`]. Non-finite results are clamped ([`finite_or_zero`]).
+pub fn rd_derivatives_by_differences(
+    f: impl Fn(f64) -> f64,
+    r: f64,
+    scale: f64,
+) -> (f64, f64, f64) {
+    let r = r.abs();
+    let scale = if scale.is_finite() && scale > 0.0 {
+        scale
+    } else {
+        1.0
+    };
+    let h = 1e-3 * r.max(1e-2 * scale);
+    let (f0, fp, fm) = (f(r), f(r + h), f((r - h).abs()));
+    (
+        finite_or_zero(f0),
+        finite_or_zero((fp - fm) / (2.0 * h)),
+        finite_or_zero((fp - 2.0 * f0 + fm) / (h * h)),
+    )
+}
+
+/// `x` if finite, ±`f64::MAX` for ±∞, 0 for NaN.
+#[inline]
+pub fn finite_or_zero(x: f64) -> f64 {
+    if x.is_nan() {
+        0.0
+    } else {
+        x.clamp(-f64::MAX, f64::MAX)
+    }
 }
 
 /// c = 1 − 2 C₁(η) = ∫ F_t(η, cos θ) cos θ dω / π: the normalisation that makes the

@@ -408,6 +408,12 @@ impl Bssrdf for PhotonBeamDiffusion {
         self.profile.rd(ch, r)
     }
 
+    /// The derivatives of the blended Catmull-Rom spline
+    /// ([`OpticalProfile::rd_derivatives`]).
+    fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {
+        self.profile.rd_derivatives(ch, r.abs())
+    }
+
     fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
         self.effective_albedo(ch)
     }

@@ -373,6 +373,46 @@ impl SplineRow {
         }
     }
 
+    /// [`eval_over_x`](Self::eval_over_x) g(x) = p(x)/x with its first two derivatives,
+    /// (g, g′, g″), from the segment's polynomial: g′ = p′/x − p/x², g″ = p″/x − 2p′/x² +
+    /// 2p/x³; in a first interval from x₀ = 0 (c₀ = 0) exactly g = (c₁ + c₂t + c₃t²)/w,
+    /// g′ = (c₂ + 2c₃t)/w², g″ = 2c₃/w³, so the limit at 0 is finite. The spline is C¹, so g″
+    /// jumps at the knots (the segment of `interval(x)` is used). (0, 0, 0) where
+    /// `eval_over_x` is 0 by definition (beyond the last knot, x < 0, NaN); non-finite results
+    /// are clamped ([`crate::finite_or_zero`]).
+    #[inline]
+    pub fn eval_over_x_derivatives(&self, x: f64) -> (f64, f64, f64) {
+        if !(x >= 0.0 && x <= self.x_max()) {
+            return (0.0, 0.0, 0.0);
+        }
+        let i = self.index.interval(x);
+        let s = &self.segments[i];
+        let t = ((x - s.x0) * s.inv_width).min(1.0);
+        let c = &s.c;
+        let w = s.inv_width;
+        let (g0, g1, g2) = if i == 0 && s.x0 == 0.0 {
+            (
+                (c[1] + t * (c[2] + t * c[3])) * w,
+                (c[2] + 2.0 * t * c[3]) * w * w,
+                2.0 * c[3] * w * w * w,
+            )
+        } else {
+            let p = s.at(t);
+            let p1 = s.slope_at(t) * w;
+            let p2 = (2.0 * c[2] + 6.0 * c[3] * t) * w * w;
+            (
+                p / x,
+                p1 / x - p / (x * x),
+                p2 / x - 2.0 * p1 / (x * x) + 2.0 * p / (x * x * x),
+            )
+        };
+        (
+            crate::finite_or_zero(g0),
+            crate::finite_or_zero(g1),
+            crate::finite_or_zero(g2),
+        )
+    }
+
     /// Samples x with density p(x)/∫p from `u ∈ [0, 1)`: the interval by bisection over the
     /// running integral, then Newton-bisection on the segment's integral (pbrt 3rd ed. §8.6.2).
     /// Returns `None` when the row has no positive mass.
@@ -610,6 +650,27 @@ impl OpticalProfile {
         };
         let v = row.eval_over_x(r * st) * (st * st / (2.0 * std::f64::consts::PI));
         if v.is_finite() { v.max(0.0) } else { 0.0 }
+    }
+
+    /// (R_d, R_d′, R_d″) of channel `ch` at r: the row's
+    /// [`SplineRow::eval_over_x_derivatives`] at x = σ_t r scaled by σ_t²/(2π), σ_t³/(2π),
+    /// σ_t⁴/(2π); (0, 0, 0) wherever [`OpticalProfile::rd`] is 0 (its clamp at 0 included).
+    pub fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {
+        let v = self.rd(ch, r);
+        if !(v > 0.0) {
+            return (0.0, 0.0, 0.0);
+        }
+        let st = self.sigma_t[ch];
+        let Some(row) = &self.rows[ch] else {
+            return (0.0, 0.0, 0.0);
+        };
+        let (_, g1, g2) = row.eval_over_x_derivatives(r * st);
+        let k = st * st / (2.0 * std::f64::consts::PI);
+        (
+            v,
+            crate::finite_or_zero(g1 * k * st),
+            crate::finite_or_zero(g2 * k * st * st),
+        )
     }
 
     /// The radius of quantile `u` of channel `ch`'s sampling distribution (finite, ≥ 0).

@@ -47,6 +47,39 @@ impl Channel {
     }
 }
 
+impl Channel {
+    /// (R_d, R_d′, R_d″) in closed form. With d = √(r² + z²) and s = σ_tr d, each source's
+    /// term T(d) = z (1 + s) e^{−s}/d³ has T′(d) = −z e^{−s} (s² + 3s + 3)/d⁴ and
+    /// T″(d) = z e^{−s} (s³ + 5s² + 12s + 12)/d⁵ (differentiating Jensen et al. 2001 Eq. 4
+    /// term by term), and d′(r) = r/d, d″(r) = z²/d³, so R′ = T′ r/d and
+    /// R″ = T″ (r/d)² + T′ z²/d³ (the derivatives of the even function R_d(r), R′(0) = 0).
+    fn derivatives(&self, r: f64) -> (f64, f64, f64) {
+        if self.alpha_p <= 0.0 {
+            return (0.0, 0.0, 0.0);
+        }
+        let k = self.alpha_p / (4.0 * std::f64::consts::PI);
+        let (mut v, mut d1, mut d2) = (0.0, 0.0, 0.0);
+        for z in [self.z_r, self.z_v] {
+            let d = distance(r, z);
+            let s = self.sigma_tr * d;
+            let e = (-s).exp();
+            let d3 = d * d * d;
+            let t0 = z * (1.0 + s) * e / d3;
+            let t1 = -z * e * (s * s + 3.0 * s + 3.0) / (d3 * d);
+            let t2 = z * e * (s * (s * (s + 5.0) + 12.0) + 12.0) / (d3 * d * d);
+            let (a, b) = (r / d, z * z / d3);
+            v += t0;
+            d1 += t1 * a;
+            d2 += t2 * a * a + t1 * b;
+        }
+        (
+            crate::finite_or_zero((k * v).max(0.0)),
+            crate::finite_or_zero(k * d1),
+            crate::finite_or_zero(k * d2),
+        )
+    }
+}
+
 impl ClosedFormTail for Channel {
     fn tail(&self, r: f64) -> f64 {
         let t = |z: f64| {
@@ -137,6 +170,9 @@ impl Bssrdf for StandardDipole {
     }
     fn rd(&self, ch: usize, r: f64) -> f64 {
         self.ch[ch].rd(r.abs())
+    }
+    fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {
+        self.ch[ch].derivatives(r.abs())
     }
     fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
         self.ch[ch].total

@@ -81,6 +81,7 @@ fn method_seconds(name: &str) -> f64 {
         "separable" => 0.015,
         "single-tree" => 0.5,
         "dual-tree" => 0.7,
+        "dual-tree-fmm" => 0.3,
         "manylight" => 1.2,
         "mdlc" => 0.5,
         "eelc" => 1.4,

@@ -215,9 +215,9 @@ pub fn curvature_at_hits(frame: &Frame<'_>, o: u32) -> Result<(Vec<u32>, Vec<f64
 
 /// The shading points of every visible translucent object with their s_p, and the G-buffer
 /// index of each, per object.
-type ObjectPoints = Vec<Option<(Vec<PixelPoint>, Vec<u32>)>>;
+pub(crate) type ObjectPoints = Vec<Option<(Vec<PixelPoint>, Vec<u32>)>>;
 
-fn shading_points(frame: &Frame<'_>) -> Result<ObjectPoints, Error> {
+pub(crate) fn shading_points(frame: &Frame<'_>) -> Result<ObjectPoints, Error> {
     let scene = frame.scene;
     // B_s and the B_θ table once per visible material.
     let bandwidths: Vec<Option<MaterialBandwidth>> = frame
@@ -417,7 +417,7 @@ fn label_colour(label: u64) -> Rgb {
 
 /// The task roots: pixel-tree nodes with at most [`TASK_ITEMS`] points whose parent has more
 /// (or the root), in tree order.
-fn tasks(px: &PixelTree) -> Vec<u32> {
+pub(crate) fn tasks(px: &PixelTree) -> Vec<u32> {
     let mut out = Vec::new();
     if px.tree.nodes.is_empty() {
         return out;

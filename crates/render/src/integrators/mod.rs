@@ -23,6 +23,7 @@
 
 pub mod baseline;
 pub mod dual_tree;
+pub mod dual_tree_fmm;
 pub mod eelc;
 pub mod exact;
 pub mod manylight;
@@ -135,6 +136,7 @@ pub const METHODS: &[Method] = &[
     separable::METHOD,
     single_tree::METHOD,
     dual_tree::METHOD,
+    dual_tree_fmm::METHOD,
     manylight::METHOD,
     mdlc::METHOD,
     eelc::METHOD,

@@ -14,7 +14,9 @@ use sss_render::integrators::MethodOptions;
 /// 4096, takes about 12 s a render even on a 24×18 frame).
 pub fn cheap(name: &str) -> MethodOptions {
     match name {
-        "exact" | "single-tree" | "dual-tree" => MethodOptions::new().with("spacing", 2.0),
+        "exact" | "single-tree" | "dual-tree" | "dual-tree-fmm" => {
+            MethodOptions::new().with("spacing", 2.0)
+        }
         "pathtrace" => MethodOptions::new().with("spp", 2),
         "mdlc" | "eelc" => MethodOptions::new().with("irradiance-points", 32),
         _ => MethodOptions::new(),

@@ -1,0 +1,652 @@
+//! A dual-tree traversal with **local expansions** (the fast multipole method's idea,
+//! Greengard & Rokhlin 1987, in the dual-tree form of Gray & Moore 2001): the same two trees
+//! as [`super::dual_tree`] — a kd-tree over the object's irradiance samples
+//! ([`IrradianceTree`]) and one over its shading points in screen space ([`PixelTree`]) — but
+//! an accepted pair (S, I) does not shade the pixel cluster S with one constant. It adds the
+//! source cluster's R_d, *with its gradient and Hessian*, about S's centre p_S to a local
+//! expansion kept per pixel-tree node; once a task's traversal ends the expansions are pushed
+//! down the pixel tree and evaluated at every shading point x = p_S + Δx:
+//!
+//! f(x) ≈ f(p_S) + ∇f · Δx + ½ Δxᵀ H Δx,  f(x) = Φ_I R_d(‖x − p_I‖)
+//!
+//! (order 2; order 1 stops after the gradient). For a radial R_d(r) with δ = p_S − p_I,
+//! r = ‖δ‖, u = δ/r: ∇f = Φ R′ u and H = Φ (R″ uuᵀ + (R′/r)(I − uuᵀ)). R, R′, R″ come from
+//! [`sss_bssrdf::Bssrdf::rd_derivatives`] (closed forms for the dipoles and Christensen–Burley,
+//! the spline's own derivatives for the tabulated models). The value is the single tree's
+//! disk-averaged cluster value ([`TranslucentShading::rd_sample_scene`] with the cluster's area);
+//! the derivatives are scaled by the same per-channel factor (the disk average's relative
+//! correction varies slowly with r: it is R_d's Laplacian ratio times a²/8).
+//!
+//! # The error bound behind the acceptance rule
+//! The expansion of order p about p_S is exact up to the Taylor remainder: for ‖Δx‖ ≤ r_S (the
+//! pixel node's world radius about p_S), |E_p| ≤ r_S^{p+1}/(p+1)! · sup ‖D^{p+1} f‖ over the
+//! node, where every point is at least d_n = ‖p_S − p_I‖ − r_S from p_I. The profiles here are
+//! sums of terms r^{−k} e^{−σ r} (dipoles, Burley; the tabulated ones are smooth fits of such
+//! shapes), whose m-th derivative is bounded by R_d(d_n) · C_m (k/d_n + σ)^m, so the relative
+//! error of an accepted pair is
+//!
+//! |E_p| / f ≲ C ((r_S/d_n) + σ r_S)^{p+1}:
+//!
+//! order p + 1 in r_S/d_n. The acceptance tests that ratio directly, in solid-angle form, from
+//! both sides (symmetric acceptance):
+//!
+//! - the source seen from the nearest pixel: Δω_I = A_I / d_n² < ε (the single tree's test, at
+//!   the nearest pixel rather than at p_S, which bounds the monopole error of the cluster,
+//!   O((r_I/d)²) about its irradiance-weighted centre, for every pixel of S);
+//! - the pixel node seen from the source: π r_S² / d_n² < ε_px = K ε (K = `--px-ratio`, 4 by
+//!   default): this is the (r_S/d_n)^{p+1} of the remainder, O(ε^{(p+1)/2});
+//! - d_n > 0 and the world boxes of S and I disjoint, so r → 0 is never expanded about.
+//!
+//! Otherwise the wider node (world radius about its centre) is split; a pair of leaves sums
+//! sample by sample with the same [`TranslucentShading::add_point_sum`] as `exact`. At ε → 0
+//! nothing is accepted and the method equals `exact` over the same samples to rounding. One
+//! parameter ε trades time for error (ε_px follows it).
+//!
+//! # What the paper's ρ / s_p does here
+//! The σ r_S part of the bound is not controlled by the solid angles: a pixel node far from a
+//! source may still be wide against the profile's decay length 1/σ. That is what the
+//! bandwidth analysis measures: s_p (Milaenen et al. Eq. 4–5) folds the profile's spatial
+//! bandwidth B_s into the pixel sampling rate, and ρ / max s_p pixels is the largest cluster
+//! over which the shading is band-limited. `--cap-rho ρ` (0, off, by default) keeps that test
+//! as a cap on the pixel-node size: an expansion is accepted only when also
+//! LENGTH(S) · max s_p < ρ (the paper's Eq. 6); a pair that passes everything but the cap
+//! splits S, and at a leaf evaluates the cluster at each of its points (the paper's SHADE
+//! below P). The Fourier stage runs only with the cap. Without it, the far-field
+//! exponential part of the remainder is left to ε_px: at the distances where a pair is
+//! accepted R_d is already small in absolute terms, and the measurements in the README (and
+//! `cargo xtask compare --trees`) show the error falling with ε without a floor.
+//!
+//! # Work split
+//! As in [`super::dual_tree`]: the pixel tree is cut into task subtrees of at most
+//! [`TASK_ITEMS`] points (a rule of the tree alone), DUAL(T, root) runs per task in parallel,
+//! each task holds the local expansions of its own subtree and pushes them down once at its
+//! end, so results do not depend on the thread count. Radial models only.
+
+use super::dual_tree::{self, PIXEL_LEAF, TASK_ITEMS};
+use super::exact::{SAMPLE_OPTIONS, sample_settings};
+use super::single_tree::{
+    self, Counts, accepts, add_samples, check_radial, eps_option, illumination_tree_bytes,
+    illumination_trees, rd_times,
+};
+use super::{Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Sweep, add_scaled};
+use crate::Error;
+use crate::frame::Frame;
+use crate::irradiance::IrradianceSettings;
+use crate::progress::Progress;
+use crate::shading::TranslucentShading;
+use glam::DVec3;
+use rayon::prelude::*;
+use sss_bssrdf::Rgb;
+use sss_hierarchy::{IrradianceCluster, IrradianceTree, PixelPoint, PixelTree};
+use sss_scene::Scene;
+use std::f64::consts::PI;
+
+/// The options: the irradiance-sample options, ε, the ratio ε_px / ε, the expansion order and
+/// the optional ρ / s_p cap.
+pub const OPTIONS: [OptionSpec; 6] = [
+    SAMPLE_OPTIONS[0],
+    SAMPLE_OPTIONS[1],
+    single_tree::OPTIONS[2],
+    OptionSpec {
+        name: "px-ratio",
+        value_name: "K",
+        default: "4",
+        help: "ε_px / ε of the local-expansion dual tree: a pixel node of world radius r takes a \
+               source's expansion only when π r² / d² < K ε (d: the source's distance to the \
+               node's nearest pixel)",
+        kind: OptionKind::Value,
+        values: &[],
+    },
+    OptionSpec {
+        name: "expansion-order",
+        value_name: "P",
+        default: "2",
+        help: "Order of the local expansions (1: value and gradient, 2: and the Hessian)",
+        kind: OptionKind::Value,
+        values: &["1", "2"],
+    },
+    OptionSpec {
+        name: "cap-rho",
+        value_name: "R",
+        default: "0",
+        help: "If > 0, a pixel node takes an expansion only when its screen extent is below \
+               ρ / max s_p pixels (Milaenen et al. Eq. 6 as a cap; 0: off, no Fourier stage)",
+        kind: OptionKind::Value,
+        values: &[],
+    },
+];
+
+/// The registry entry.
+pub const METHOD: Method = Method {
+    name: "dual-tree-fmm",
+    about: "Dual tree (irradiance samples × pixels) with second-order local expansions per \
+            pixel node and symmetric acceptance",
+    options: &OPTIONS,
+    build: |o| Ok(Box::new(DualTreeFmm::from_options(o)?)),
+    sweep: Sweep {
+        option: "eps",
+        label: "eps",
+        values: single_tree::eps_sweep,
+    },
+};
+
+/// The `dual-tree-fmm` integrator and its settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualTreeFmm {
+    /// Irradiance sample placement and lighting.
+    pub irradiance: IrradianceSettings,
+    /// The solid-angle threshold ε (the source seen from the nearest pixel).
+    pub eps: f64,
+    /// ε_px / ε (the pixel node seen from the source).
+    pub px_ratio: f64,
+    /// Expansion order: 1 or 2.
+    pub order: u8,
+    /// ρ of the optional Eq. 6 cap on the pixel-node size (0: off).
+    pub cap_rho: f64,
+}
+
+impl Default for DualTreeFmm {
+    fn default() -> Self {
+        DualTreeFmm {
+            irradiance: IrradianceSettings::default(),
+            eps: 0.05,
+            px_ratio: 4.0,
+            order: 2,
+            cap_rho: 0.0,
+        }
+    }
+}
+
+impl DualTreeFmm {
+    /// The settings `options` describe.
+    pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
+        let px_ratio: f64 = o.get(&OPTIONS, "px-ratio")?;
+        if !(px_ratio.is_finite() && px_ratio >= 0.0) {
+            return Err(Error::Input(format!(
+                "--px-ratio must be finite and >= 0, got {px_ratio}"
+            )));
+        }
+        let order: u8 = o.get(&OPTIONS, "expansion-order")?;
+        if !(order == 1 || order == 2) {
+            return Err(Error::Input(format!(
+                "--expansion-order must be 1 or 2, got {order}"
+            )));
+        }
+        let cap_rho: f64 = o.get(&OPTIONS, "cap-rho")?;
+        if !(cap_rho.is_finite() && cap_rho >= 0.0) {
+            return Err(Error::Input(format!(
+                "--cap-rho must be finite and >= 0, got {cap_rho}"
+            )));
+        }
+        Ok(DualTreeFmm {
+            irradiance: sample_settings(o)?,
+            eps: eps_option(o, &OPTIONS)?,
+            px_ratio,
+            order,
+            cap_rho,
+        })
+    }
+}
+
+/// R_d and its first two radial derivatives per channel at scene-unit distance `r`, in scene
+/// units (R_d(r/u)/u², R_d′(r/u)/u³, R_d″(r/u)/u⁴ with u the scene units per mm).
+pub fn rd_derivatives_scene(sh: &TranslucentShading, r: f64) -> [[f64; 3]; 3] {
+    let u = sh.units_per_mm;
+    let m = sh.bssrdf();
+    let x = r / u;
+    let s0 = 1.0 / (u * u);
+    let (s1, s2) = (s0 / u, s0 / (u * u));
+    std::array::from_fn(|c| {
+        let (v, d1, d2) = m.rd_derivatives(c, x);
+        [v * s0, d1 * s1, d2 * s2]
+    })
+}
+
+/// A local expansion about a pixel node's centre, per channel: value, gradient and the
+/// symmetric Hessian (xx, xy, xz, yy, yz, zz).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LocalExpansion {
+    /// Whether anything was added.
+    pub set: bool,
+    /// Value at the centre.
+    pub value: Rgb,
+    /// Gradient per channel.
+    pub gradient: [DVec3; 3],
+    /// Hessian per channel (xx, xy, xz, yy, yz, zz).
+    pub hessian: [[f64; 6]; 3],
+}
+
+#[inline]
+fn quadratic(h: &[f64; 6], d: DVec3) -> f64 {
+    h[0] * d.x * d.x
+        + h[3] * d.y * d.y
+        + h[5] * d.z * d.z
+        + 2.0 * (h[1] * d.x * d.y + h[2] * d.x * d.z + h[4] * d.y * d.z)
+}
+
+#[inline]
+fn times(h: &[f64; 6], d: DVec3) -> DVec3 {
+    DVec3::new(
+        h[0] * d.x + h[1] * d.y + h[2] * d.z,
+        h[1] * d.x + h[3] * d.y + h[4] * d.z,
+        h[2] * d.x + h[4] * d.y + h[5] * d.z,
+    )
+}
+
+impl LocalExpansion {
+    /// Adds the expansion of a radial source about `centre`: per channel, `weight` times the
+    /// value `rd[c][0]`, the gradient `rd[c][1]` u and (order 2) the Hessian
+    /// `rd[c][2]` uuᵀ + (`rd[c][1]`/r)(I − uuᵀ), with `delta` = centre − source (r = ‖delta‖ > 0).
+    pub fn add_radial(&mut self, delta: DVec3, rd: &[[f64; 3]; 3], weight: Rgb, order: u8) {
+        let r = delta.length();
+        if !(r > 0.0 && r.is_finite()) {
+            return;
+        }
+        let u = delta / r;
+        self.set = true;
+        for c in 0..3 {
+            let w = weight[c];
+            let [v, d1, d2] = rd[c];
+            self.value[c] += w * v;
+            self.gradient[c] += u * (w * d1);
+            if order >= 2 {
+                let b = w * d1 / r;
+                let a = w * d2 - b;
+                let h = &mut self.hessian[c];
+                h[0] += a * u.x * u.x + b;
+                h[1] += a * u.x * u.y;
+                h[2] += a * u.x * u.z;
+                h[3] += a * u.y * u.y + b;
+                h[4] += a * u.y * u.z;
+                h[5] += a * u.z * u.z + b;
+            }
+        }
+    }
+
+    /// The expansion at centre + `d` (order 1: value and gradient only).
+    #[inline]
+    pub fn eval(&self, d: DVec3, order: u8) -> Rgb {
+        std::array::from_fn(|c| {
+            let mut x = self.value[c] + self.gradient[c].dot(d);
+            if order >= 2 {
+                x += 0.5 * quadratic(&self.hessian[c], d);
+            }
+            x
+        })
+    }
+
+    /// Adds this expansion, re-centred at centre + `d`, to `out` (exact for the polynomial).
+    fn shift_into(&self, d: DVec3, order: u8, out: &mut LocalExpansion) {
+        out.set = true;
+        let v = self.eval(d, order);
+        for c in 0..3 {
+            out.value[c] += v[c];
+            out.gradient[c] += self.gradient[c];
+            if order >= 2 {
+                out.gradient[c] += times(&self.hessian[c], d);
+                for k in 0..6 {
+                    out.hessian[c][k] += self.hessian[c][k];
+                }
+            }
+        }
+    }
+}
+
+/// The largest distance from `p` to a corner of the box [lo, hi].
+fn radius_about(p: DVec3, lo: DVec3, hi: DVec3) -> f64 {
+    (hi - p).abs().max((p - lo).abs()).length()
+}
+
+/// One task's state: its pixel subtree's expansions and point sums.
+struct Task<'s> {
+    root: u32,
+    start: usize,
+    acc: &'s mut [Rgb],
+    local: Vec<LocalExpansion>,
+    visits: u64,
+    clusters: u64,
+    samples: u64,
+}
+
+struct Fmm<'a> {
+    px: &'a PixelTree,
+    irr: &'a IrradianceTree,
+    /// Shading points in the pixel tree's order.
+    points: &'a [PixelPoint],
+    sh: &'a TranslucentShading,
+    eps: f64,
+    eps_px: f64,
+    order: u8,
+    cap_rho: f64,
+    /// World radius of each pixel node about its centre.
+    px_radius: Vec<f64>,
+    /// World radius of each illumination node about its cluster position.
+    irr_radius: Vec<f64>,
+}
+
+impl Fmm<'_> {
+    /// The symmetric acceptance of the module docs: `Some(true)` accepted, `Some(false)`
+    /// accepted but for the ρ / s_p cap, `None` refused.
+    fn accepts(&self, s: u32, i: u32, dn: f64) -> Option<bool> {
+        let (su, iu) = (s as usize, i as usize);
+        let rs = self.px_radius[su];
+        let cl = &self.irr.clusters[iu];
+        let dn2 = dn * dn;
+        if !(dn > 0.0 && accepts(cl.area, dn2, self.eps) && PI * rs * rs < self.eps_px * dn2) {
+            return None;
+        }
+        let c = &self.px.clusters[su];
+        let n = &self.irr.tree.nodes[iu];
+        let disjoint = (0..3).any(|k| c.world_hi[k] < n.lo[k] || n.hi[k] < c.world_lo[k]);
+        disjoint.then(|| {
+            self.cap_rho <= 0.0
+                || self.px.length_px(&self.px.tree.nodes[su]) * c.max_rate < self.cap_rho
+        })
+    }
+
+    /// DUAL(S, I) with local expansions.
+    fn dual(&self, s: u32, i: u32, t: &mut Task<'_>) {
+        t.visits += 1;
+        let sn = &self.px.tree.nodes[s as usize];
+        let inode = &self.irr.tree.nodes[i as usize];
+        let sc = &self.px.clusters[s as usize];
+        let cl = &self.irr.clusters[i as usize];
+        let rs = self.px_radius[s as usize];
+        let delta = sc.position - cl.position;
+        let dn = delta.length() - rs;
+        match self.accepts(s, i, dn) {
+            Some(true) => {
+                self.expand(s, cl, delta, t);
+                return;
+            }
+            // Wider than the cap allows: a leaf evaluates the cluster at each of its points
+            // (as the paper's SHADE below P), an inner node is split.
+            Some(false) if sn.is_leaf() => {
+                for k in sn.start as usize..sn.end as usize {
+                    let x = self.points[k].position;
+                    let rd = self.sh.rd_sample_scene((cl.position - x).length(), cl.area);
+                    add_scaled(&mut t.acc[k - t.start], rd_times(rd, cl.flux), 1.0);
+                }
+                t.clusters += sn.len() as u64;
+                return;
+            }
+            Some(false) => {
+                self.dual(sn.left, i, t);
+                self.dual(sn.right, i, t);
+                return;
+            }
+            None => {}
+        }
+        match (sn.is_leaf(), inode.is_leaf()) {
+            (true, true) => {
+                let pts = self.irr.points_of(inode);
+                for k in sn.start as usize..sn.end as usize {
+                    add_samples(
+                        &mut t.acc[k - t.start],
+                        pts,
+                        self.points[k].position,
+                        self.sh,
+                    );
+                }
+                t.samples += (pts.len() * sn.len()) as u64;
+            }
+            (true, false) => {
+                self.dual(s, inode.left, t);
+                self.dual(s, inode.right, t);
+            }
+            (false, true) => {
+                self.dual(sn.left, i, t);
+                self.dual(sn.right, i, t);
+            }
+            (false, false) => {
+                if rs >= self.irr_radius[i as usize] {
+                    self.dual(sn.left, i, t);
+                    self.dual(sn.right, i, t);
+                } else {
+                    self.dual(s, inode.left, t);
+                    self.dual(s, inode.right, t);
+                }
+            }
+        }
+    }
+
+    /// Adds cluster `cl`'s expansion about pixel node `s`'s centre (`delta` = p_S − p_I).
+    fn expand(&self, s: u32, cl: &IrradianceCluster, delta: DVec3, t: &mut Task<'_>) {
+        t.clusters += 1;
+        let r = delta.length();
+        let disk = self.sh.rd_sample_scene(r, cl.area);
+        let mut rd = rd_derivatives_scene(self.sh, r);
+        for c in 0..3 {
+            // The disk average as the value, the point derivatives scaled by its ratio.
+            let k = if rd[c][0] > 0.0 {
+                disk[c] / rd[c][0]
+            } else {
+                0.0
+            };
+            let k = if k.is_finite() { k } else { 0.0 };
+            rd[c] = [disk[c], rd[c][1] * k, rd[c][2] * k];
+        }
+        let local = &mut t.local[(s - t.root) as usize];
+        local.add_radial(delta, &rd, cl.flux, self.order);
+    }
+
+    /// Pushes the task's expansions down its subtree and evaluates them at its points.
+    fn push_down(&self, t: &mut Task<'_>) {
+        let root = t.root as usize;
+        for n in root..root + t.local.len() {
+            let loc = t.local[n - root];
+            if !loc.set {
+                continue;
+            }
+            let node = &self.px.tree.nodes[n];
+            let centre = self.px.clusters[n].position;
+            if node.is_leaf() {
+                for k in node.start as usize..node.end as usize {
+                    let v = loc.eval(self.points[k].position - centre, self.order);
+                    add_scaled(&mut t.acc[k - t.start], v, 1.0);
+                }
+            } else {
+                for ch in [node.left, node.right] {
+                    let d = self.px.clusters[ch as usize].position - centre;
+                    let mut out = t.local[ch as usize - root];
+                    loc.shift_into(d, self.order, &mut out);
+                    t.local[ch as usize - root] = out;
+                }
+            }
+        }
+    }
+}
+
+/// The number of nodes in the pre-order subtree of `s` (it spans `s..s + count`).
+fn subtree_nodes(px: &PixelTree, s: u32) -> usize {
+    let mut last = s;
+    loop {
+        let n = &px.tree.nodes[last as usize];
+        if n.is_leaf() {
+            return (last - s) as usize + 1;
+        }
+        last = n.right;
+    }
+}
+
+/// The shading points of every visible translucent object without s_p (the cap is off), and
+/// the G-buffer index of each, per object.
+fn plain_points(frame: &Frame<'_>) -> dual_tree::ObjectPoints {
+    let width = frame.gbuffer.width.max(1);
+    let mut out: dual_tree::ObjectPoints = (0..frame.scene.objects.len()).map(|_| None).collect();
+    for &o in &frame.visible {
+        if frame.shading_of(o).is_none() {
+            continue;
+        }
+        let index: Vec<u32> = (0..frame.gbuffer.samples.len() as u32)
+            .filter(|&i| frame.gbuffer.samples[i as usize].object == o)
+            .collect();
+        let points = index
+            .iter()
+            .map(|&i| {
+                let g = &frame.gbuffer.samples[i as usize];
+                PixelPoint {
+                    screen: [
+                        f64::from(g.pixel % width) + 0.5,
+                        f64::from(g.pixel / width) + 0.5,
+                    ],
+                    position: g.p,
+                    normal: g.n,
+                    view: g.wo,
+                    rate: 0.0,
+                }
+            })
+            .collect();
+        out[o as usize] = Some((points, index));
+    }
+    out
+}
+
+impl Integrator for DualTreeFmm {
+    fn name(&self) -> &'static str {
+        METHOD.name
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "ε = {}, ε_px = {} ε, order {}, ρ cap {}, irradiance sample spacing {} mean free \
+             paths, at most {} per object",
+            self.eps,
+            self.px_ratio,
+            self.order,
+            if self.cap_rho > 0.0 {
+                self.cap_rho.to_string()
+            } else {
+                "off".into()
+            },
+            self.irradiance.spacing_mfp,
+            self.irradiance.max_samples
+        )
+    }
+
+    fn irradiance_settings(&self) -> Option<IrradianceSettings> {
+        Some(self.irradiance)
+    }
+
+    fn structure_bytes(&self, scene: &Scene, samples: &[(usize, u64, u64)]) -> u64 {
+        // As the paper's dual tree (points, sums, the pixel tree), plus a radius per node of
+        // both trees and, per thread, one task's expansions.
+        let cam = &scene.camera;
+        let points = u64::from(cam.width)
+            .saturating_mul(u64::from(cam.height))
+            .saturating_mul(u64::from(cam.pixel_samples.max(1)));
+        let n = usize::try_from(points).unwrap_or(usize::MAX / 2);
+        let per = 2 * std::mem::size_of::<PixelPoint>() as u64 + 24 + 4;
+        let nodes = 2 * points.div_ceil((PIXEL_LEAF / 2).max(1) as u64);
+        let irr_nodes: u64 = samples.iter().fold(0u64, |a, e| a.saturating_add(e.1));
+        let task = (2 * TASK_ITEMS as u64) * std::mem::size_of::<LocalExpansion>() as u64;
+        illumination_tree_bytes(samples)
+            .saturating_add(points.saturating_mul(per))
+            .saturating_add(PixelTree::bytes_for(n, PIXEL_LEAF))
+            .saturating_add(nodes.saturating_add(irr_nodes).saturating_mul(8))
+            .saturating_add(task.saturating_mul(rayon::current_num_threads() as u64))
+    }
+
+    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        check_radial(frame, METHOD.name)?;
+        let samples = frame.irradiance_samples(&self.irradiance);
+        let trees = frame.timed("illumination_tree", || illumination_trees(frame, &samples));
+        let points = if self.cap_rho > 0.0 {
+            frame.timed("fourier", || dual_tree::shading_points(frame))?
+        } else {
+            plain_points(frame)
+        };
+        let pixel_trees: Vec<Option<PixelTree>> = frame.timed("shading_tree", || {
+            points
+                .iter()
+                .map(|p| p.as_ref().map(|(pts, _)| PixelTree::build(pts, PIXEL_LEAF)))
+                .collect()
+        });
+        let counts = Counts::default();
+        let mut values = vec![[0.0; 3]; frame.gbuffer.samples.len()];
+        let mut shaded_points = 0u64;
+        frame.timed("shading", || {
+            for &o in &frame.visible {
+                let (Some(sh), Some(irr), Some(px), Some((pts, index))) = (
+                    frame.shading_of(o),
+                    trees[o as usize].as_ref(),
+                    pixel_trees[o as usize].as_ref(),
+                    points[o as usize].as_ref(),
+                ) else {
+                    continue;
+                };
+                let ordered: Vec<PixelPoint> =
+                    px.tree.order.iter().map(|&k| pts[k as usize]).collect();
+                shaded_points += ordered.len() as u64;
+                let mut acc = vec![[0.0; 3]; ordered.len()];
+                if !irr.tree.nodes.is_empty() && !px.tree.nodes.is_empty() {
+                    let fmm = Fmm {
+                        px,
+                        irr,
+                        points: &ordered,
+                        sh,
+                        eps: self.eps,
+                        eps_px: self.px_ratio * self.eps,
+                        order: self.order,
+                        cap_rho: self.cap_rho,
+                        px_radius: px
+                            .clusters
+                            .iter()
+                            .map(|c| radius_about(c.position, c.world_lo, c.world_hi))
+                            .collect(),
+                        irr_radius: irr
+                            .tree
+                            .nodes
+                            .iter()
+                            .zip(&irr.clusters)
+                            .map(|(n, c)| {
+                                radius_about(c.position, DVec3::from(n.lo), DVec3::from(n.hi))
+                            })
+                            .collect(),
+                    };
+                    // Disjoint slices of `acc`, one per task, in tree order.
+                    let roots = dual_tree::tasks(px);
+                    let mut slices = Vec::with_capacity(roots.len());
+                    let mut rest: &mut [Rgb] = &mut acc;
+                    for &s in &roots {
+                        let (a, b) = rest.split_at_mut(px.tree.nodes[s as usize].len());
+                        slices.push((s, a));
+                        rest = b;
+                    }
+                    slices.into_par_iter().for_each(|(s, slice)| {
+                        let mut t = Task {
+                            root: s,
+                            start: px.tree.nodes[s as usize].start as usize,
+                            acc: slice,
+                            local: vec![LocalExpansion::default(); subtree_nodes(px, s)],
+                            visits: 0,
+                            clusters: 0,
+                            samples: 0,
+                        };
+                        fmm.dual(s, 0, &mut t);
+                        fmm.push_down(&mut t);
+                        counts.add(t.visits, t.clusters, t.samples);
+                        progress.advance(t.acc.len() as u64);
+                    });
+                } else {
+                    progress.advance(ordered.len() as u64);
+                }
+                for (k, &item) in px.tree.order.iter().enumerate() {
+                    let gi = index[item as usize] as usize;
+                    let g = &frame.gbuffer.samples[gi];
+                    // A truncated expansion may dip below 0 where the sum is near 0.
+                    let a = acc[k].map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
+                    let mut v = [0.0; 3];
+                    add_scaled(&mut v, a, sh.exit_weight(g.n, g.wo));
+                    values[gi] = v;
+                }
+            }
+        });
+        progress.advance(frame.gbuffer.samples.len() as u64 - shaded_points);
+        Ok(Shaded {
+            values,
+            stats: counts.stats("node_pairs_visited"),
+            ..Shaded::default()
+        })
+    }
+}
