@@ -45,6 +45,12 @@ pub fn uniforms(n: usize, seed: u64) -> Vec<f64> {
     (0..n).map(|_| rng.random::<f64>()).collect()
 }
 
+/// Radius (mm) of the sphere in [`Frame::closeup`]: a head's size.
+pub const CLOSEUP_RADIUS_MM: f64 = 90.0;
+
+/// Footprint (mm per pixel) at the centre of [`Frame::closeup`].
+pub const CLOSEUP_MM_PER_PIXEL: f64 = 0.06;
+
 /// A screen-space filter frame of the benchmarks (`benches/separable.rs`, `benches/gpu.rs`):
 /// the irradiance, depth (mm), object ids and footprint (mm per pixel) of every pixel.
 pub struct Frame {
@@ -94,6 +100,28 @@ impl Frame {
         f
     }
 
+    /// The `1080p-closeup` frame: the same texture on a face-sized sphere (radius
+    /// [`CLOSEUP_RADIUS_MM`], a head's) seen in an orthographic close-up that the sphere fills,
+    /// [`CLOSEUP_MM_PER_PIXEL`] across at its centre. A pixel at distance ρ (mm) from the
+    /// centre sees the surface tilted by θ with sin θ = ρ / R, so its footprint is
+    /// 0.06 / cos θ mm (0.060 at the centre to 0.088 in the corners of a 1920 × 1080 frame)
+    /// and its depth 600 + R − R cos θ mm. At this scale a skin kernel's taps land tens of
+    /// pixels from the centre: the close-ups engine developers render most often.
+    pub fn closeup(width: usize, height: usize) -> Frame {
+        let mut f = Frame::new(width, height);
+        let (cx, cy) = (0.5 * width as f64, 0.5 * height as f64);
+        let r = CLOSEUP_RADIUS_MM;
+        for (i, (d, m)) in f.depth.iter_mut().zip(&mut f.mm_per_pixel).enumerate() {
+            let u = ((i % width) as f64 + 0.5 - cx) * CLOSEUP_MM_PER_PIXEL;
+            let v = ((i / width) as f64 + 0.5 - cy) * CLOSEUP_MM_PER_PIXEL;
+            // Frames larger than the sphere clamp at a grazing 0.05 (never a zero cosine).
+            let cos = (1.0 - (u * u + v * v) / (r * r)).max(0.0025).sqrt();
+            *m = (CLOSEUP_MM_PER_PIXEL / cos) as f32;
+            *d = (600.0 + r * (1.0 - cos)) as f32;
+        }
+        f
+    }
+
     /// The frame as the filter's input.
     pub fn input(&self) -> sss_separable::ScreenInput<'_> {
         sss_separable::ScreenInput {
@@ -118,5 +146,32 @@ mod tests {
         assert!(r.windows(2).all(|w| w[0] < w[1]));
         assert_eq!(uniforms(8, 3), uniforms(8, 3));
         assert_ne!(uniforms(8, 3), uniforms(8, 4));
+    }
+
+    #[test]
+    fn closeup_is_a_sphere_at_the_stated_scale() {
+        let f = Frame::closeup(1920, 1080);
+        let (lo, hi) = f
+            .mm_per_pixel
+            .iter()
+            .fold((f32::MAX, 0.0f32), |(a, b), &m| (a.min(m), b.max(m)));
+        // The close-up range, 0.05-0.1 mm a pixel: 0.06 at the centre, 1/cos θ out.
+        assert!(
+            (lo - 0.06).abs() < 1e-4 && hi > 0.085 && hi < 0.09,
+            "{lo} {hi}"
+        );
+        // Depth and footprint on one sphere: depth − 600 = R (1 − 0.06 / footprint).
+        for i in [0, 1919, 960 * 1080 + 7, 1920 * 1080 - 1, 540 * 1920 + 960] {
+            let want = CLOSEUP_RADIUS_MM * (1.0 - CLOSEUP_MM_PER_PIXEL / f.mm_per_pixel[i] as f64);
+            assert!((f.depth[i] as f64 - 600.0 - want).abs() < 1e-3, "pixel {i}");
+        }
+        // A frame wider than the sphere stays finite.
+        let g = Frame::closeup(6000, 100);
+        assert!(
+            g.mm_per_pixel
+                .iter()
+                .chain(&g.depth)
+                .all(|v| v.is_finite() && *v > 0.0)
+        );
     }
 }

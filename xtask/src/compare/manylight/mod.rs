@@ -7,7 +7,10 @@
 //! a scanned dragon in skin1 with the standard dipole (thin claws, deep folds: [`DRAGON`]).
 //!
 //! 1. **Bias**: each method's image mean (the summed luminance over the scored subset) over
-//!    the reference's, with its standard error ([`Score::bias`]).
+//!    the reference's, with its standard error ([`Score::bias`]); for manylight also with the
+//!    paper's final estimate (`manylight-paper`: the samples the stopping test saw, at
+//!    ε ≥ 5 %, where its sequential-stopping bias shows) beside ours (new samples of the final
+//!    triplets, `sss_manylight::Settings::fresh_final`).
 //! 2. **Estimation accuracy** (Table 1, Fig. 10): the fraction of pixels whose relative error
 //!    (of the luminance) is below ε, at ε ∈ {10, 5, 2, 1} % and α = 95 %, over a seeded
 //!    uniform subset of translucent pixels and several estimator streams.
@@ -405,12 +408,15 @@ enum Method {
 
 /// The name of `manylight` in the CSV's `method` column.
 const OURS: &str = "manylight";
+/// The label of manylight with the paper's final estimate (the samples the stopping test saw).
+const PAPER: &str = "manylight-paper";
 
 impl Method {
     /// The `method` column: `manylight`, or the baseline and its points (`mdlc-is`,
     /// `eelc-uniform`, …).
     fn label(&self) -> &'static str {
         match self {
+            Method::Ours(m) if !m.fresh_final => PAPER,
             Method::Ours(_) => OURS,
             Method::Mdlc(m) if m.points.uniform => "mdlc-uniform",
             Method::Mdlc(_) => "mdlc-is",
@@ -810,6 +816,18 @@ impl Experiment for ManyLightExperiment {
             for &eps in &p.eps {
                 for k in 0..p.seeds {
                     run(&ours(eps), &scene, "accuracy", cfg.seed + 1 + k, &mut rows)?;
+                }
+            }
+            // 1b. The paper's final estimate (the samples the stopping test saw) at the loose
+            // ε, where its sequential-stopping bias shows, on the same streams.
+            for &eps in p.eps.iter().filter(|&&e| e >= 0.05) {
+                for k in 0..p.seeds {
+                    let m = Method::Ours(ManyLight {
+                        eps,
+                        fresh_final: false,
+                        ..base(ctx, VPLS)
+                    });
+                    run(&m, &scene, "paper-estimate", cfg.seed + 1 + k, &mut rows)?;
                 }
             }
             // 2. Max-Extent at the fixed ε (BSSRDF-aware's rows are the sweep's at that ε).
@@ -1418,7 +1436,7 @@ fn bias_table(rows: &[Row], refs: &[(&'static str, Reference, usize)]) -> String
     for (name, _, _) in refs {
         let mut keys: Vec<(&'static str, f64, u32)> = Vec::new();
         for r in rows.iter().filter(|r| {
-            r.scene == *name && (r.experiment == "accuracy" || r.experiment == "quality")
+            r.scene == *name && matches!(r.experiment, "accuracy" | "quality" | "paper-estimate")
         }) {
             let k = (r.method, r.eps, r.points);
             if !keys.contains(&k) {
@@ -1430,7 +1448,7 @@ fn bias_table(rows: &[Row], refs: &[(&'static str, Reference, usize)]) -> String
                 .iter()
                 .filter(|r| {
                     r.scene == *name
-                        && (r.experiment == "accuracy" || r.experiment == "quality")
+                        && matches!(r.experiment, "accuracy" | "quality" | "paper-estimate")
                         && r.method == method
                         && r.eps == eps
                         && r.points == points
@@ -1674,6 +1692,7 @@ fn report(
                     && x.eps == p.fixed_eps
                     && x.selection == sel
                     && x.seed == rows.iter().map(|y| y.seed).min().unwrap_or(0)
+                    && x.method == OURS
                     && (x.experiment == "accuracy" || x.experiment == "selection")
             })
         };
