@@ -31,7 +31,7 @@
 //!    noise (∝ N^−½): N bounds the error they can reach at any ε; at a fixed ε their own
 //!    estimate's error (EELC's about ours' at the same ε) bounds it at any N.
 //!
-//! **The reference** ([`reference`]) is the path tracer on the subset pixels, with the paths
+//! **The reference** ([`reference()`]) is the path tracer on the subset pixels, with the paths
 //! each pixel needs for a relative standard error of [`Budget::target_rel_se`] (and the finer
 //! [`Budget::fine_rel_se`] on the first [`Budget::fine_pixels`] of the seeded subset): no VPLs,
 //! clusters, bounds or stopping rule, so it can show a bias of the many-light estimator, which a
