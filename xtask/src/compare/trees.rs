@@ -8,8 +8,9 @@
 //!    at 1024² (Fig. 6);
 //! 2. the stage breakdown per ε on one thread at 1024² (Table 1);
 //! 3. scaling with the pixel count, 256² to 2048², at ε = 0.05 (all three);
-//! 4. pictures: s_p, the pixel clusters (Fig. 5), and each method's relative difference from
-//!    the finest single-tree image.
+//! 4. pictures: s_p, the pixel clusters (Fig. 5), each method's relative difference from
+//!    the finest single-tree image, and the paper's dual tree's beside `dual-tree-fmm`'s at
+//!    equal time.
 //!
 //! Error is measured against `exact` (the point sum both trees approximate, over the same
 //! irradiance samples) on a seeded uniform random subset of [`super::subset::SUBSET_PIXELS`] translucent pixels:
@@ -435,6 +436,48 @@ fn pictures(ctx: &Context<'_>, runs: &[TreeRun], res: u32) -> Result<(), Error> 
     };
     let exposure = sss_render::image::auto_exposure(&finest.out.subsurface);
     let covered: Vec<bool> = finest.out.coverage.iter().map(|&c| c > 0.0).collect();
+    let difference = |r: &TreeRun| -> Vec<Option<f64>> {
+        r.out
+            .subsurface
+            .iter()
+            .zip(&finest.out.subsurface)
+            .zip(&covered)
+            .map(|((a, b), &c)| {
+                let m = (b[0] + b[1] + b[2]) / 3.0;
+                (c && m > 0.0).then(|| ((a[0] + a[1] + a[2]) / 3.0 - m).abs() / m)
+            })
+            .collect()
+    };
+    if let Some((d, f)) = equal_time_pair(&sweep) {
+        // Side by side, one colour scale (0 to 1 %), each against the finest single-tree
+        // image: the paper's dual tree on the left, the local expansions given no more time
+        // on the right, a 16-pixel gap between.
+        let gap = 16usize;
+        let n = res as usize;
+        let (a, b) = (difference(d), difference(f));
+        let mut values = Vec::with_capacity(n * (2 * n + gap));
+        for y in 0..n {
+            values.extend_from_slice(&a[y * n..(y + 1) * n]);
+            values.extend(std::iter::repeat_n(None, gap));
+            values.extend_from_slice(&b[y * n..(y + 1) * n]);
+        }
+        write_error_map(
+            &dir.join("equal_time_difference.png"),
+            2 * res + gap as u32,
+            res,
+            &values,
+            0.01,
+            &format!(
+                "left: dual-tree eps={} rho={RHO}, {:.2} s | right: dual-tree-fmm eps={}, {:.2} s",
+                d.eps,
+                d.total(),
+                f.eps,
+                f.total(),
+            ),
+            "|a-b|/b",
+        )
+        .map_err(|e| Error(e.to_string()))?;
+    }
     for r in &sweep {
         let name = format!("{}_eps{}", r.method, r.eps);
         sss_render::image::write_png(
@@ -448,17 +491,7 @@ fn pictures(ctx: &Context<'_>, runs: &[TreeRun], res: u32) -> Result<(), Error> 
         if std::ptr::eq(*r, *finest) {
             continue;
         }
-        let values: Vec<Option<f64>> = r
-            .out
-            .subsurface
-            .iter()
-            .zip(&finest.out.subsurface)
-            .zip(&covered)
-            .map(|((a, b), &c)| {
-                let m = (b[0] + b[1] + b[2]) / 3.0;
-                (c && m > 0.0).then(|| ((a[0] + a[1] + a[2]) / 3.0 - m).abs() / m)
-            })
-            .collect();
+        let values = difference(r);
         write_error_map(
             &dir.join(format!("{name}_difference.png")),
             res,
@@ -521,6 +554,31 @@ fn pictures(ctx: &Context<'_>, runs: &[TreeRun], res: u32) -> Result<(), Error> 
         }
     }
     Ok(())
+}
+
+/// The equal-time pair of the pictures: the paper's dual tree at [`FIXED_EPS`] and ρ = [`RHO`],
+/// and the most accurate `dual-tree-fmm` run of the sweep that took no more total time (the
+/// fastest one if none did).
+fn equal_time_pair<'r>(sweep: &[&'r TreeRun]) -> Option<(&'r TreeRun, &'r TreeRun)> {
+    let d = *sweep
+        .iter()
+        .find(|r| r.method == "dual-tree" && r.rho == Some(RHO) && r.eps == FIXED_EPS)?;
+    let fmm: Vec<&TreeRun> = sweep
+        .iter()
+        .copied()
+        .filter(|r| r.method == "dual-tree-fmm")
+        .collect();
+    let within = fmm
+        .iter()
+        .copied()
+        .filter(|r| r.total() <= d.total())
+        .min_by(|a, b| a.score.rmse.total_cmp(&b.score.rmse));
+    let f = within.or_else(|| {
+        fmm.iter()
+            .copied()
+            .min_by(|a, b| a.total().total_cmp(&b.total()))
+    })?;
+    Some((d, f))
 }
 
 fn plots(ctx: &Context<'_>, runs: &[TreeRun], p: &Plan) -> Result<(), Error> {
@@ -786,11 +844,11 @@ fn report(runs: &[TreeRun], p: &Plan, refs: &[(u32, SubsetReference)], threads: 
         ],
         &rows,
     ));
-    let growth = |method: &str| {
-        let sh = |res: u32| {
+    let growth = |method: &str, stage: Option<&str>| {
+        let t = |res: u32| {
             runs.iter()
                 .find(|r| is_scaling(r, p) && r.method == method && r.resolution == res)
-                .map(|r| r.stage("shading"))
+                .map(|r| stage.map_or_else(|| r.total(), |s| r.stage(s)))
         };
         let (lo, hi) = (p.resolutions.first()?, p.resolutions.last()?);
         let lo = if p.resolutions.contains(&512) {
@@ -798,23 +856,42 @@ fn report(runs: &[TreeRun], p: &Plan, refs: &[(u32, SubsetReference)], threads: 
         } else {
             lo
         };
-        Some((*lo, *hi, sh(*hi)? / sh(*lo)?.max(1e-9)))
+        Some((*lo, *hi, t(*hi)? / t(*lo)?.max(1e-9)))
     };
     for m in ["single-tree", "dual-tree", "dual-tree-fmm"] {
-        if let Some((lo, hi, g)) = growth(m) {
+        if let (Some((lo, hi, g)), Some((_, _, gs))) = (growth(m, None), growth(m, Some("shading")))
+        {
             let _ = writeln!(
                 summary,
-                "- {m}: final shading grows {g:.2}× from {lo}² to {hi}² ({:.0}× the pixels; goal \
-                 for the dual trees ≤ 5× over 16×)",
+                "- {m}: total time grows {g:.2}× (final shading {gs:.2}×) from {lo}² to {hi}² \
+                 ({:.0}× the pixels; goal for the dual trees ≤ 5× over 16×)",
                 (f64::from(hi) / f64::from(lo)).powi(2)
             );
         }
+    }
+    let sweep: Vec<&TreeRun> = runs
+        .iter()
+        .filter(|r| r.experiment == "eps" && r.resolution == sr)
+        .collect();
+    if let Some((d, f)) = equal_time_pair(&sweep) {
+        let _ = writeln!(
+            summary,
+            "\nAt equal time (`trees/equal_time_difference.png`): the paper's dual tree (ε = {}, \
+             ρ = {RHO}) {} s at RMSE {}; dual-tree-fmm (ε = {}) {} s at RMSE {} ({:.1}× lower).",
+            d.eps,
+            md_num(Some(d.total()), 3),
+            md_num(Some(d.score.rmse), 3),
+            f.eps,
+            md_num(Some(f.total()), 3),
+            md_num(Some(f.score.rmse), 3),
+            d.score.rmse / f.score.rmse.max(1e-300)
+        );
     }
     let _ = writeln!(
         body,
         "\nFiles: `trees.csv` (every run), `trees_error_vs_time.png`, `trees_scaling.png`, \
          `trees/` (images per ε, relative differences from the finest single-tree image, \
-         `sampling_rate.png`, `pixel_clusters.png`)."
+         `equal_time_difference.png`, `sampling_rate.png`, `pixel_clusters.png`)."
     );
     Section {
         title: "Trees: single (Jensen & Buhler) against dual (Milaenen et al.; local expansions) \
