@@ -429,7 +429,8 @@ impl Fmm<'_> {
         // S small enough, seen from the source, but the source too wide to be one cluster: a
         // leaf of samples expands each sample about S (particle to local) if every one of them
         // passes the test; an inner source node is split while S is small in the profile's
-        // length there too.
+        // length there too (tested as for one sample of the node's whole area at its centre,
+        // so a node whose disk would reach within three radii of S is refined as for neither).
         if ok.pixels {
             if !inode.is_leaf() {
                 if self.expansion(rs, delta, cl.area, true).is_some() {
@@ -474,13 +475,17 @@ impl Fmm<'_> {
         }
     }
 
-    /// The expansion coefficients (R_d, R_d′, R_d″ per channel, the value disk-averaged over
-    /// `area`, the derivatives scaled by the same ratio) of a source at `delta` = p_S − p from
-    /// pixel node S of world radius `rs`, if S passes the pixel test in the profile's own
-    /// length: π r_S² / min(d_n, 2λ)² < ε_px with d_n = ‖delta‖ − r_S > 0 and λ = R_d/|R_d′|
-    /// (per channel, at ‖delta‖) the local decay length. For R_d ∝ r⁻² (the diffusion
-    /// profiles without their exponential) 2λ = r and the test is the geometric one; where the
-    /// exponential dominates, λ → 1/σ and the test bounds the σ r_S part of the remainder.
+    /// The expansion coefficients (value, first and second radial derivative per channel) of
+    /// a source of `area` at `delta` = p_S − p from pixel node S of world radius `rs`, if S
+    /// passes the pixel test π r_S² / d² < ε_px with d = d_n = ‖delta‖ − r_S > 0.
+    ///
+    /// A cluster (`near` false): the disk-averaged value with R_d's derivatives scaled by the
+    /// same ratio. A single sample (`near`): the disk average with its own derivatives, only
+    /// where the average is in its far branch (≥ 3 disk radii), and d = min(d_n, 2λ) with
+    /// λ = R_d/|R_d′| (per channel, at ‖delta‖) the local decay length. For R_d ∝ r⁻² (the
+    /// diffusion profiles without their exponential) 2λ = r and the test is the geometric
+    /// one; where the exponential dominates, λ → 1/σ and the test bounds the σ r_S part of the
+    /// remainder.
     fn expansion(&self, rs: f64, delta: DVec3, area: f64, near: bool) -> Option<[[f64; 3]; 3]> {
         let r = delta.length();
         let dn = r - rs;
