@@ -433,7 +433,7 @@ impl Fmm<'_> {
         // so a node whose disk would reach within three radii of S is refined as for neither).
         if ok.pixels {
             if !inode.is_leaf() {
-                if self.expansion(rs, delta, cl.area, true).is_some() {
+                if self.passing_derivatives(rs, delta, cl.area, true).is_some() {
                     self.dual(s, inode.left, t);
                     self.dual(s, inode.right, t);
                     return;
@@ -487,6 +487,34 @@ impl Fmm<'_> {
     /// one; where the exponential dominates, λ → 1/σ and the test bounds the σ r_S part of the
     /// remainder.
     fn expansion(&self, rs: f64, delta: DVec3, area: f64, near: bool) -> Option<[[f64; 3]; 3]> {
+        let mut rd = self.passing_derivatives(rs, delta, area, near)?;
+        let disk = self.sh.rd_sample_scene(delta.length(), area);
+        for c in 0..3 {
+            if near {
+                rd[c][0] = disk[c];
+                continue;
+            }
+            // The disk average as the value, the point derivatives scaled by its ratio.
+            let k = if rd[c][0] > 0.0 {
+                disk[c] / rd[c][0]
+            } else {
+                0.0
+            };
+            let k = if k.is_finite() { k } else { 0.0 };
+            rd[c] = [disk[c], rd[c][1] * k, rd[c][2] * k];
+        }
+        Some(rd)
+    }
+
+    /// The tests of [`Self::expansion`] alone, with the derivatives they were made on (the
+    /// value not yet the disk average for a cluster): enough to decide a split.
+    fn passing_derivatives(
+        &self,
+        rs: f64,
+        delta: DVec3,
+        area: f64,
+        near: bool,
+    ) -> Option<[[f64; 3]; 3]> {
         let r = delta.length();
         let dn = r - rs;
         if !(dn > 0.0) {
@@ -495,7 +523,7 @@ impl Fmm<'_> {
         // A single sample near the pixels: its disk average with the average's own
         // derivatives (none where the average is a quadrature: it is summed instead). A
         // cluster, far by A_I/d_n² < ε: R_d's derivatives scaled by the disk's ratio.
-        let mut rd = if near {
+        let rd = if near {
             self.sh.rd_sample_derivatives_scene(r, area)?
         } else {
             rd_derivatives_scene(self.sh, r)
@@ -510,21 +538,6 @@ impl Fmm<'_> {
             if !(rs * rs < limit * reach * reach) {
                 return None;
             }
-        }
-        let disk = self.sh.rd_sample_scene(r, area);
-        for c in 0..3 {
-            if near {
-                rd[c][0] = disk[c];
-                continue;
-            }
-            // The disk average as the value, the point derivatives scaled by its ratio.
-            let k = if rd[c][0] > 0.0 {
-                disk[c] / rd[c][0]
-            } else {
-                0.0
-            };
-            let k = if k.is_finite() { k } else { 0.0 };
-            rd[c] = [disk[c], rd[c][1] * k, rd[c][2] * k];
         }
         Some(rd)
     }
