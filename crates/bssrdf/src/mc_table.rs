@@ -1935,6 +1935,10 @@ impl Bssrdf for McTableModel {
         self.profile.rd(ch, r)
     }
 
+    fn rd_rgb(&self, r: f64) -> Rgb {
+        self.profile.rd_rgb(r)
+    }
+
     /// The derivatives of the blended Catmull-Rom spline
     /// ([`OpticalProfile::rd_derivatives`]).
     fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {

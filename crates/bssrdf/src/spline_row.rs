@@ -639,7 +639,15 @@ impl OpticalProfile {
         }
     }
 
+    /// R_d(r) of the three channels, each as [`OpticalProfile::rd`] computes it (one call
+    /// instead of three through a model's `dyn Bssrdf`, on the disk average's hot path).
+    #[inline]
+    pub fn rd_rgb(&self, r: f64) -> crate::Rgb {
+        [self.rd(0, r), self.rd(1, r), self.rd(2, r)]
+    }
+
     /// R_d(r) of channel `ch`: finite and ≥ 0, 0 for r < 0 or not finite.
+    #[inline]
     pub fn rd(&self, ch: usize, r: f64) -> f64 {
         if !(r >= 0.0) || !r.is_finite() {
             return 0.0;

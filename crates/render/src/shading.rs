@@ -152,24 +152,29 @@ impl TranslucentShading {
     /// R_d t′, D″ = R_d″ (1 + t) + 2 R_d′ t′ + R_d t″, with t = a²/8 · ∇²R_d/R_d the disk's
     /// correction and R_d′, R_d″ from [`sss_bssrdf::Bssrdf::rd_derivatives`]; t′ and t″ by
     /// central differences one step of the correction's table apart (the table is linear
-    /// between its steps, so a narrower difference would see its kinks). `None` where
-    /// `rd_sample_scene` takes its near branch (the disk average by quadrature), so a caller
-    /// expanding a sample about another point falls back to summing it.
+    /// between its steps, so a narrower difference would see its kinks).
+    ///
+    /// Where `rd_sample_scene` takes its near branch (the disk average by quadrature): the
+    /// quadrature [`disk_average`](Self::disk_average) at r and its central differences
+    /// [`DISK_NEAR_STEP`] disk radii apart (the quadrature is a smooth function of r outside
+    /// the disk, its rule's nodes moving with r), for r ≥ [`DISK_NEAR_MIN_RATIO`] disk radii
+    /// only; `None` nearer (the average's derivatives are singular at the disk's edge, r =
+    /// a), so a caller expanding a sample about another point falls back to summing it. The
+    /// caller's expansion must also stay clear of the edge: its error grows as the distance
+    /// from the expansion's points to the disk's edge shrinks.
     pub fn rd_sample_derivatives_scene(&self, r: f64, area: f64) -> Option<[[f64; 3]; 3]> {
         if !(area > 0.0 && area.is_finite() && r.is_finite() && r > 0.0) {
             return None;
         }
         let a2 = area / PI;
-        if r < DISK_FAR_RATIO * a2.sqrt() {
-            return None;
-        }
+        let a = a2.sqrt();
         let u = self.units_per_mm;
         let x = r / u;
         let scale = a2 / (u * u) * 0.125;
         let t = |x: f64| self.disk.laplacian(x).map(|l| scale * l);
         let t0 = t(x);
-        if t0.iter().any(|t| !(t.abs() <= DISK_FAR_MAX_CORRECTION)) {
-            return None;
+        if r < DISK_FAR_RATIO * a || t0.iter().any(|t| !(t.abs() <= DISK_FAR_MAX_CORRECTION)) {
+            return self.near_derivatives(r, a);
         }
         let h = x * (1.0 - (-1.0 / self.disk.per_ln).exp());
         let (tp, tm) = (t(x + h), t(x - h));
@@ -185,6 +190,28 @@ impl TranslucentShading {
                 v * k * s0,
                 (d1 * k + v * t1) * s1,
                 (d2 * k + 2.0 * d1 * t1 + v * t2) * s2,
+            ]
+        });
+        out.iter().flatten().all(|v| v.is_finite()).then_some(out)
+    }
+
+    /// [`rd_sample_derivatives_scene`](Self::rd_sample_derivatives_scene)'s near branch: the
+    /// quadrature and its central differences.
+    fn near_derivatives(&self, r: f64, a: f64) -> Option<[[f64; 3]; 3]> {
+        if !(r >= DISK_NEAR_MIN_RATIO * a) {
+            return None;
+        }
+        let h = DISK_NEAR_STEP * a;
+        let (lo, mid, hi) = (
+            self.disk_average(r - h, a),
+            self.disk_average(r, a),
+            self.disk_average(r + h, a),
+        );
+        let out: [[f64; 3]; 3] = std::array::from_fn(|c| {
+            [
+                mid[c],
+                (hi[c] - lo[c]) / (2.0 * h),
+                (hi[c] - 2.0 * mid[c] + lo[c]) / (h * h),
             ]
         });
         out.iter().flatten().all(|v| v.is_finite()).then_some(out)
@@ -377,6 +404,15 @@ pub const DISK_FAR_RATIO: f64 = 3.0;
 /// corrections (coarse irradiance samples on steep profiles) mean that the neglected
 /// fourth-order term may not be small, and the disk is integrated instead.
 pub const DISK_FAR_MAX_CORRECTION: f64 = 0.125;
+
+/// [`TranslucentShading::rd_sample_derivatives_scene`] differentiates the near branch's
+/// quadrature only at and beyond this many disk radii (its derivatives are singular at the
+/// disk's edge, one radius away).
+pub const DISK_NEAR_MIN_RATIO: f64 = 1.25;
+
+/// The step, in disk radii, of the near branch's central differences (at most a fifth of the
+/// distance to the disk's edge at [`DISK_NEAR_MIN_RATIO`]).
+pub const DISK_NEAR_STEP: f64 = 0.05;
 
 /// Gauss–Legendre points per panel of the inner part of the disk average.
 const DISK_INNER_POINTS: usize = 6;
@@ -619,9 +655,11 @@ mod tests {
     /// 0.1 to 4 smallest reduced mean free paths and r/a ∈ {0, 0.5, 1, 2, 5, 20}.
     #[test]
     fn the_disk_average_derivatives_match_its_finite_differences() {
-        // D′ and D″ of the far branch against central differences of rd_sample_scene itself
-        // (h = 10⁻³ r, inside one step of the correction's table except by chance), and no
-        // derivatives where the average is a quadrature (r < 3 disk radii). The closed-form
+        // D′ and D″ against central differences of rd_sample_scene itself (h = 10⁻³ r, inside
+        // one step of the far branch's correction table except by chance, and a fortieth of
+        // the near branch's own step, so its O(h²) error shows), in the far branch and in the
+        // near one (the quadrature, r < 3 disk radii), and no derivatives within 1.25 disk
+        // radii (the average's derivatives are singular at the disk's edge). The closed-form
         // models only: the tabulated ones' splines have second derivatives that jump at their
         // knots, which a difference across one does not see (their R_d′ and R_d″ are checked
         // inside knot intervals in the bssrdf crate's tests).
@@ -639,8 +677,8 @@ mod tests {
                     * u;
                 let area = (0.5 * mfp).powi(2);
                 let a = (area / PI).sqrt();
-                assert!(sh.rd_sample_derivatives_scene(2.9 * a, area).is_none());
-                for f in [3.5, 6.0, 15.0] {
+                assert!(sh.rd_sample_derivatives_scene(1.2 * a, area).is_none());
+                for f in [1.3, 1.6, 2.2, 2.9, 3.5, 6.0, 15.0] {
                     let r = f * a;
                     let Some(d) = sh.rd_sample_derivatives_scene(r, area) else {
                         continue;

@@ -49,19 +49,26 @@
 //!   own, if every one of them passes the pixel test at its own distance (a leaf whose box is
 //!   disjoint from S's may still hold a sample within S's radius) and in the profile's own
 //!   length (below);
-//! - **neither**: the wider node (world radius about its centre) is split; a pair of leaves
-//!   sums sample by sample with the same [`TranslucentShading::add_point_sum`] as `exact`.
+//! - **neither**: the wider node (world radius about its centre) is split; at a pair of
+//!   leaves each sample that passes the single-sample test on its own is expanded about S, and
+//!   the others are summed at every point of S with the same
+//!   [`TranslucentShading::add_point_sum`] as `exact` (the samples of one leaf sit at
+//!   different distances from S, so the farther ones of a leaf that straddles the near field
+//!   still pass).
 //!
 //! The particle-to-local step is what keeps the cost from growing with the pixel count: the
 //! samples near a pixel are no longer summed at every pixel of a leaf but expanded once per
 //! pixel node that is small enough, and those nodes shrink in world size as the pixels do.
-//! What is left per pixel is the samples within three disk radii of it, where `exact`'s disk
-//! average is a quadrature ([`TranslucentShading::rd_sample_scene`]'s near branch; about nine
-//! samples at the default spacing): those are summed. A single sample's expansion carries its
-//! disk average's own derivatives ([`TranslucentShading::rd_sample_derivatives_scene`]: the
-//! average's correction grows towards the sample, so scaling R_d's derivatives by the
-//! average's ratio, as for clusters, errs there; measured on the `--trees` bunny at 2048²,
-//! ε = 0.05: RMSE 7.6e-4 with the scaling, 8.4e-5 with the derivatives).
+//! A single sample's expansion carries its disk average's own derivatives
+//! ([`TranslucentShading::rd_sample_derivatives_scene`]: the average's correction grows
+//! towards the sample, so scaling R_d's derivatives by the average's ratio, as for clusters,
+//! errs there; measured on the `--trees` bunny at 2048², ε = 0.05: RMSE 7.6e-4 with the
+//! scaling, 8.4e-5 with the derivatives); within three disk radii, where `exact`'s average is
+//! a quadrature, those are the quadrature's own central differences, and the distance in the
+//! test is taken to the disk's edge (d_n − a), where the average's derivatives are singular.
+//! What is left per pixel is the samples whose disk is too close for any pixel node around
+//! the pixel to pass (about nine at the default spacing, a pixel leaf being wider than a
+//! fifth of the disk at the `--trees` bunny's 2048²): those are summed.
 //! Single samples are expanded near the pixels, where the profile's exponential, not the
 //! distance, sets how fast it changes; the σ r_S part of the remainder is then bounded by the
 //! same test with d_n replaced by min(d_n, 2λ), λ = R_d/|R_d′| the local decay length at the
@@ -107,7 +114,7 @@ use crate::Error;
 use crate::frame::Frame;
 use crate::irradiance::IrradianceSettings;
 use crate::progress::Progress;
-use crate::shading::TranslucentShading;
+use crate::shading::{DISK_FAR_RATIO, TranslucentShading};
 use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
@@ -433,7 +440,8 @@ impl Fmm<'_> {
         // so a node whose disk would reach within three radii of S is refined as for neither).
         if ok.pixels {
             if !inode.is_leaf() {
-                if self.passing_derivatives(rs, delta, cl.area, true).is_some() {
+                let far = delta.length() >= DISK_FAR_RATIO * (cl.area / PI).sqrt();
+                if far && self.passing_derivatives(rs, delta, cl.area, true).is_some() {
                     self.dual(s, inode.left, t);
                     self.dual(s, inode.right, t);
                     return;
@@ -443,18 +451,7 @@ impl Fmm<'_> {
             }
         }
         match (sn.is_leaf(), inode.is_leaf()) {
-            (true, true) => {
-                let pts = self.irr.points_of(inode);
-                for k in sn.start as usize..sn.end as usize {
-                    add_samples(
-                        &mut t.acc[k - t.start],
-                        pts,
-                        self.points[k].position,
-                        self.sh,
-                    );
-                }
-                t.samples += (pts.len() * sn.len()) as u64;
-            }
+            (true, true) => self.leaf_pair(s, i, rs, t),
             (true, false) => {
                 self.dual(s, inode.left, t);
                 self.dual(s, inode.right, t);
@@ -480,20 +477,20 @@ impl Fmm<'_> {
     /// passes the pixel test π r_S² / d² < ε_px with d = d_n = ‖delta‖ − r_S > 0.
     ///
     /// A cluster (`near` false): the disk-averaged value with R_d's derivatives scaled by the
-    /// same ratio. A single sample (`near`): the disk average with its own derivatives, only
-    /// where the average is in its far branch (≥ 3 disk radii), and d = min(d_n, 2λ) with
+    /// same ratio. A single sample (`near`): the disk average with its own derivatives (none
+    /// within 1.25 disk radii), and d = min(d_n − a, 2λ) with a the disk's radius and
     /// λ = R_d/|R_d′| (per channel, at ‖delta‖) the local decay length. For R_d ∝ r⁻² (the
     /// diffusion profiles without their exponential) 2λ = r and the test is the geometric
     /// one; where the exponential dominates, λ → 1/σ and the test bounds the σ r_S part of the
     /// remainder.
     fn expansion(&self, rs: f64, delta: DVec3, area: f64, near: bool) -> Option<[[f64; 3]; 3]> {
         let mut rd = self.passing_derivatives(rs, delta, area, near)?;
+        if near {
+            // The value is the disk average's already.
+            return Some(rd);
+        }
         let disk = self.sh.rd_sample_scene(delta.length(), area);
         for c in 0..3 {
-            if near {
-                rd[c][0] = disk[c];
-                continue;
-            }
             // The disk average as the value, the point derivatives scaled by its ratio.
             let k = if rd[c][0] > 0.0 {
                 disk[c] / rd[c][0]
@@ -517,7 +514,13 @@ impl Fmm<'_> {
     ) -> Option<[[f64; 3]; 3]> {
         let r = delta.length();
         let dn = r - rs;
-        if !(dn > 0.0) {
+        let limit = self.eps_px / PI;
+        // A single sample's average is singular at its disk's edge: the reach is measured
+        // from S to the edge, d_n − a.
+        let dn = if near { dn - (area / PI).sqrt() } else { dn };
+        // The geometric test first: every reach below is at most d_n, and it costs no
+        // evaluation of the profile.
+        if !(dn > 0.0 && rs * rs < limit * dn * dn) {
             return None;
         }
         // A single sample near the pixels: its disk average with the average's own
@@ -528,7 +531,6 @@ impl Fmm<'_> {
         } else {
             rd_derivatives_scene(self.sh, r)
         };
-        let limit = self.eps_px / PI;
         for d in &rd {
             let reach = if near && d[0] > 0.0 && d[1] != 0.0 {
                 dn.min(2.0 * d[0] / d[1].abs())
@@ -566,6 +568,39 @@ impl Fmm<'_> {
         true
     }
 
+    /// A pair of leaves that the node tests did not accept: each sample that passes
+    /// [`Self::expansion`] on its own about S is expanded (particle to local), the others are
+    /// summed at every point of S as `exact` sums them. The samples of one leaf sit at
+    /// different distances from S, so in a leaf that straddles the near field the farther
+    /// samples still pass (on the `--trees` bunny at 2048² most leaf pairs are such).
+    fn leaf_pair(&self, s: u32, i: u32, rs: f64, t: &mut Task<'_>) {
+        let sn = &self.px.tree.nodes[s as usize];
+        let pts = self.irr.points_of(&self.irr.tree.nodes[i as usize]);
+        let centre = self.px.clusters[s as usize].position;
+        for p in pts {
+            let delta = centre - p.position;
+            // An expansion costs about what a few point evaluations do: not worth trying for
+            // a node of fewer points.
+            if sn.len() >= EXPAND_MIN_POINTS
+                && let Some(rd) = self.expansion(rs, delta, p.area, true)
+            {
+                let flux = p.irradiance.map(|e| e * p.area);
+                self.add_expansion(s, delta, &rd, flux, t);
+                t.sample_expansions += 1;
+                continue;
+            }
+            for k in sn.start as usize..sn.end as usize {
+                add_samples(
+                    &mut t.acc[k - t.start],
+                    std::slice::from_ref(p),
+                    self.points[k].position,
+                    self.sh,
+                );
+            }
+            t.samples += sn.len() as u64;
+        }
+    }
+
     /// Adds a source's expansion (coefficients from [`Self::expansion`]) with weight `flux`
     /// about pixel node `s`'s centre (`delta` = p_S − p).
     fn add_expansion(&self, s: u32, delta: DVec3, rd: &[[f64; 3]; 3], flux: Rgb, t: &mut Task<'_>) {
@@ -599,6 +634,9 @@ impl Fmm<'_> {
         }
     }
 }
+
+/// Pixel leaves of fewer points sum a sample at each point instead of trying its expansion.
+const EXPAND_MIN_POINTS: usize = 3;
 
 /// The number of nodes in the pre-order subtree of `s` (it spans `s..s + count`).
 fn subtree_nodes(px: &PixelTree, s: u32) -> usize {
