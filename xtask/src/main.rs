@@ -131,7 +131,7 @@ struct CompareArgs {
     #[arg(long, value_name = "DIR")]
     mesh_dir: Vec<PathBuf>,
     /// Run only the paper-scale tree experiments (Milaenen et al. 2019 on the full-resolution
-    /// bunny from the shared meshes, 256² to 2048²; about 20–30 minutes on 2 cores, a few
+    /// bunny from the shared meshes, 256² to 2048²; about 50 minutes on 2 cores, a few
     /// with --quick) instead of the default experiments.
     #[arg(long)]
     trees: bool,

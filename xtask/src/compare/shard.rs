@@ -836,13 +836,27 @@ mod tests {
     fn shards_merge_to_the_unsharded_run() {
         let root = std::env::temp_dir().join(format!("xtask-shards-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&root);
+        std::fs::create_dir_all(&root).unwrap();
+        // The built-in sphere, small: what is tested is the bookkeeping of shards and merges,
+        // which every method's rows, pictures and report sections go through at any size (the
+        // built-in scene took most of this crate's test time in CI).
+        let scene = root.join("small.toml");
+        let text = sss_render::scene::BUILTIN_SCENES
+            .iter()
+            .find(|(n, _)| *n == "sphere")
+            .expect("the built-in sphere")
+            .1
+            .replace("resolution = [160, 120]", "resolution = [48, 36]")
+            .replace("units_per_mm = 0.05", "units_per_mm = 0.15");
+        assert!(text.contains("[48, 36]") && text.contains("0.15"), "{text}");
+        std::fs::write(&scene, text).unwrap();
         let base = Config {
             photons: 2000,
             bins: 20,
             quick: true,
             ..Config::new(
                 vec!["skin1".into()],
-                vec!["sphere".into()],
+                vec![scene.to_string_lossy().into_owned()],
                 root.join("whole"),
             )
         };
