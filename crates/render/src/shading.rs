@@ -681,6 +681,9 @@ mod tests {
                 for f in [1.3, 1.6, 2.2, 2.9, 3.5, 6.0, 15.0] {
                     let r = f * a;
                     let Some(d) = sh.rd_sample_derivatives_scene(r, area) else {
+                        // The far branch may decline (a correction too large to trust); the
+                        // near one always answers from 1.25 radii on.
+                        assert!(f > DISK_FAR_RATIO, "{model} {name}: none at {f} a");
                         continue;
                     };
                     let h = 1e-3 * r;

@@ -67,8 +67,8 @@
 //! a quadrature, those are the quadrature's own central differences, and the distance in the
 //! test is taken to the disk's edge (d_n − a), where the average's derivatives are singular.
 //! What is left per pixel is the samples whose disk is too close for any pixel node around
-//! the pixel to pass (about nine at the default spacing, a pixel leaf being wider than a
-//! fifth of the disk at the `--trees` bunny's 2048²): those are summed.
+//! the pixel to pass (within three disk radii there are about nine at the default spacing):
+//! those are summed.
 //! Single samples are expanded near the pixels, where the profile's exponential, not the
 //! distance, sets how fast it changes; the σ r_S part of the remainder is then bounded by the
 //! same test with d_n replaced by min(d_n, 2λ), λ = R_d/|R_d′| the local decay length at the
