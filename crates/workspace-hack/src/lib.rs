@@ -5,4 +5,5 @@
 //! crates both workspaces build would come out with different features and be built twice in
 //! the shared target directory. This crate's manifest asks for the union of the two feature
 //! sets; the root workspace has it as a member and the bindings depend on it, so both resolve
-//! to the same set. Nothing should depend on it but the bindings.
+//! to the same set; `xtask`, which `cargo xtask` builds alone, depends on it for the same
+//! reason. Nothing else should depend on it.
