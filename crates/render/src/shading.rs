@@ -168,12 +168,15 @@ impl TranslucentShading {
         }
         let a2 = area / PI;
         let a = a2.sqrt();
+        if r < DISK_FAR_RATIO * a {
+            return self.near_derivatives(r, a);
+        }
         let u = self.units_per_mm;
         let x = r / u;
         let scale = a2 / (u * u) * 0.125;
         let t = |x: f64| self.disk.laplacian(x).map(|l| scale * l);
         let t0 = t(x);
-        if r < DISK_FAR_RATIO * a || t0.iter().any(|t| !(t.abs() <= DISK_FAR_MAX_CORRECTION)) {
+        if t0.iter().any(|t| !(t.abs() <= DISK_FAR_MAX_CORRECTION)) {
             return self.near_derivatives(r, a);
         }
         let h = x * (1.0 - (-1.0 / self.disk.per_ln).exp());

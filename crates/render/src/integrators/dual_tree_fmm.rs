@@ -118,7 +118,7 @@ use crate::shading::{DISK_FAR_RATIO, TranslucentShading};
 use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
-use sss_hierarchy::{IrradianceTree, PixelPoint, PixelTree};
+use sss_hierarchy::{IrradiancePoint, IrradianceTree, PixelPoint, PixelTree};
 use sss_scene::Scene;
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -561,10 +561,8 @@ impl Fmm<'_> {
             }
         }
         for (p, rd) in pts.iter().zip(&coefficients) {
-            let flux = p.irradiance.map(|e| e * p.area);
-            self.add_expansion(s, centre - p.position, rd, flux, t);
+            self.add_sample_expansion(s, centre - p.position, rd, p, t);
         }
-        t.sample_expansions += pts.len() as u64;
         true
     }
 
@@ -580,16 +578,13 @@ impl Fmm<'_> {
         let sn = &self.px.tree.nodes[s as usize];
         let pts = self.irr.points_of(&self.irr.tree.nodes[i as usize]);
         let centre = self.px.clusters[s as usize].position;
+        // An expansion costs about what a few point evaluations do: not worth trying for a
+        // node of fewer points.
+        let try_expansions = sn.len() >= EXPAND_MIN_POINTS;
         for p in pts {
             let delta = centre - p.position;
-            // An expansion costs about what a few point evaluations do: not worth trying for
-            // a node of fewer points.
-            if sn.len() >= EXPAND_MIN_POINTS
-                && let Some(rd) = self.expansion(rs, delta, p.area, true)
-            {
-                let flux = p.irradiance.map(|e| e * p.area);
-                self.add_expansion(s, delta, &rd, flux, t);
-                t.sample_expansions += 1;
+            if try_expansions && let Some(rd) = self.expansion(rs, delta, p.area, true) {
+                self.add_sample_expansion(s, delta, &rd, p, t);
                 continue;
             }
             for k in sn.start as usize..sn.end as usize {
@@ -602,6 +597,21 @@ impl Fmm<'_> {
             }
             t.samples += sn.len() as u64;
         }
+    }
+
+    /// Adds single sample `p`'s expansion (coefficients from [`Self::expansion`]) about pixel
+    /// node `s`'s centre (`delta` = p_S − p), weighted by its flux, and counts it.
+    fn add_sample_expansion(
+        &self,
+        s: u32,
+        delta: DVec3,
+        rd: &[[f64; 3]; 3],
+        p: &IrradiancePoint,
+        t: &mut Task<'_>,
+    ) {
+        let flux = p.irradiance.map(|e| e * p.area);
+        self.add_expansion(s, delta, rd, flux, t);
+        t.sample_expansions += 1;
     }
 
     /// Adds a source's expansion (coefficients from [`Self::expansion`]) with weight `flux`
