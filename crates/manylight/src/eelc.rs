@@ -192,7 +192,9 @@ impl<'a> Eelc<'a> {
 
     /// ΔI for J sampled strata and Σ s_j² under the configured interval.
     pub fn delta(&self, strata: usize, sum_s2: f64) -> f64 {
-        self.settings.interval.half_width(self.t, strata, sum_s2)
+        self.settings
+            .interval
+            .half_width(self.t, strata, strata, sum_s2)
     }
 
     /// Estimates one pixel from its gather tree, a visibility test and the pixel's seed

@@ -132,7 +132,10 @@ pub use aabb::{Aabb, Sphere};
 pub use bounds::{ClusterKind, Selection};
 pub use confidence::StudentT;
 pub use eelc::{Eelc, EelcSettings};
-pub use estimator::{Estimator, Interval, PixelEstimate, Settings, Status, Visibility, pixel_seed};
+pub use estimator::{
+    Dof, Estimator, Interval, PixelEstimate, Settings, Status, Visibility, effective_dof,
+    pixel_seed,
+};
 pub use gather_tree::{
     GatherNode, GatherPoint, GatherTree, IrradiancePoint, gather_points, uniform_points,
 };

@@ -12,6 +12,8 @@ pub struct Summary {
     pub pixels: u64,
     /// Pixels that met ΔI < εI.
     pub converged: u64,
+    /// Pixels that stopped at the absolute floor on ΔI (`Settings::floor`).
+    pub floor: u64,
     /// Pixels that stopped at the triplet cap.
     pub triplet_cap: u64,
     /// Pixels in which the split cap refused at least one split.
@@ -40,6 +42,7 @@ impl Summary {
         self.pixels += 1;
         match p.status {
             Status::Converged => self.converged += 1,
+            Status::Floor => self.floor += 1,
             Status::TripletCap => self.triplet_cap += 1,
             Status::Exhausted => self.exhausted += 1,
             Status::Zero => self.zero += 1,
@@ -57,6 +60,7 @@ impl Summary {
     pub fn merge(&mut self, o: &Summary) {
         self.pixels += o.pixels;
         self.converged += o.converged;
+        self.floor += o.floor;
         self.triplet_cap += o.triplet_cap;
         self.split_cap += o.split_cap;
         self.exhausted += o.exhausted;

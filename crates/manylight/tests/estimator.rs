@@ -284,6 +284,65 @@ fn the_split_cap_holds_freezes_triplets_and_is_reported() {
     assert_eq!(sum.mean_triplets(), 7.0);
 }
 
+/// The absolute floor on ΔI: at an ε no triplet count within the cap can meet, a floor of 2 %
+/// of the brute-force value stops every pixel as `Floor`, with ΔI below the floor, long before
+/// the cap, and the reported value lies within the floor of the brute-force value about α of
+/// the time (1000 seeds, margins as the coverage test's: [0.92, 0.975]). Without the floor the
+/// same pixels run to the cap.
+#[test]
+fn the_floor_stops_a_pixel_at_an_absolute_error_that_holds() {
+    let s = scene();
+    let truth = lum(brute_force(128));
+    let mut st = Settings::new(G_MAX);
+    st.epsilon = 1e-6;
+    st.max_triplets = 20_000;
+    let floor = 0.02 * truth;
+    let v = vis();
+    let capped = estimator(&s, st).estimate(&s.shading, &v, pixel_seed(5, 0));
+    assert_eq!(
+        (capped.status, capped.triplets),
+        (Status::TripletCap, 20_000)
+    );
+    st.floor = floor;
+    let est = estimator(&s, st);
+    let n = 1000u64;
+    let mut within = 0usize;
+    let mut triplets = 0usize;
+    let mut sum = Summary::default();
+    for seed in 0..n {
+        let px = est.estimate(&s.shading, &v, pixel_seed(5, seed));
+        assert_eq!(px.status, Status::Floor, "seed {seed}");
+        assert!(px.value > 0.0 && px.delta.is_finite());
+        within += usize::from((px.value - truth).abs() < floor);
+        triplets += px.triplets;
+        sum.add(&px);
+    }
+    let acc = within as f64 / n as f64;
+    let mean = triplets as f64 / n as f64;
+    eprintln!("floor 2 %: within the floor {acc}, mean triplets {mean}");
+    assert!((0.92..=0.975).contains(&acc), "within the floor: {acc}");
+    assert!(mean < 2000.0, "mean triplets {mean}");
+    assert_eq!((sum.floor, sum.converged, sum.triplet_cap), (n, 0, 0));
+}
+
+/// A floor below εÎ never binds: the estimates are bit-identical to those without it.
+#[test]
+fn a_floor_below_the_relative_target_changes_nothing() {
+    let s = scene();
+    let truth = lum(brute_force(128));
+    let mut st = Settings::new(G_MAX);
+    st.epsilon = 0.05;
+    let plain = estimator(&s, st);
+    st.floor = 1e-4 * truth;
+    let floored = estimator(&s, st);
+    let v = vis();
+    for seed in 0..50 {
+        let a = plain.estimate(&s.shading, &v, pixel_seed(8, seed));
+        let b = floored.estimate(&s.shading, &v, pixel_seed(8, seed));
+        assert_eq!(a, b, "seed {seed}");
+    }
+}
+
 #[test]
 fn the_g_clamp_binds_near_the_surface_and_is_counted() {
     let s = scene();
@@ -346,6 +405,9 @@ fn bad_settings_are_errors() {
         |st: &mut Settings| st.g_max = f64::INFINITY,
         |st: &mut Settings| st.max_triplets = 0,
         |st: &mut Settings| st.min_triplets = 0,
+        |st: &mut Settings| st.floor = -1e-9,
+        |st: &mut Settings| st.floor = f64::NAN,
+        |st: &mut Settings| st.floor = f64::INFINITY,
     ] {
         let mut st = Settings::new(G_MAX);
         f(&mut st);
@@ -385,4 +447,23 @@ fn a_light_below_the_plane_is_dark_whatever_the_shading_normals() {
         assert!(px.value.is_finite() && px.value >= 0.0);
         assert_eq!(px.value > 0.0, lit, "light at z = {z}: {}", px.value);
     }
+}
+
+/// Satterthwaite's effective degrees of freedom against hand-worked cases: equal variances
+/// give every stratum (ν = J), one stratum carrying all the variance gives 1, and (4, 1)
+/// gives 25/17 → 1; (1, 1, 1, 0.5) gives 3.5²/3.25 = 3.77 → 3. No variance: the strata.
+#[test]
+fn the_effective_degrees_of_freedom_match_hand_worked_cases() {
+    let nu = |s2: &[f64]| {
+        let (a, b) = s2.iter().fold((0.0, 0.0), |(a, b), v| (a + v, b + v * v));
+        effective_dof(s2.len(), a, b)
+    };
+    assert_eq!(nu(&[2.0; 7]), 7);
+    assert_eq!(nu(&[5.0, 0.0, 0.0, 0.0]), 1);
+    assert_eq!(nu(&[4.0, 1.0]), 1);
+    assert_eq!(nu(&[1.0, 1.0, 1.0, 0.5]), 3);
+    assert_eq!(effective_dof(6, 0.0, 0.0), 6);
+    assert_eq!(effective_dof(0, 0.0, 0.0), 1);
+    // Rounding past J is clamped to J.
+    assert_eq!(effective_dof(3, 3.0, 2.9), 3);
 }

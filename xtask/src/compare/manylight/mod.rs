@@ -383,7 +383,7 @@ fn plan(quick: bool) -> Plan {
                 max_paths: 1 << 22,
             },
             eps: vec![0.1, 0.05, 0.02, 0.01],
-            seeds: 3,
+            seeds: 6,
             fixed_eps: 0.02,
             picture_eps: 0.1,
             vpl_factors: vec![0.5, 1.0, 2.0, 4.0, 8.0],
@@ -514,6 +514,8 @@ struct Row {
     bias_se: f64,
     /// Pixels that stopped at a cap.
     capped: u64,
+    /// Pixel estimates that stopped at the dark-pixel floor.
+    floored: u64,
 }
 
 fn selection_name(s: Selection) -> &'static str {
@@ -803,6 +805,7 @@ impl Experiment for ManyLightExperiment {
                         .iter()
                         .map(|o| o.summary.triplet_cap + o.summary.split_cap)
                         .sum(),
+                    floored: out.iter().map(|o| o.summary.floor).sum(),
                 });
                 Ok(())
             };
@@ -1010,12 +1013,12 @@ fn pictures(
 fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
         "scene,experiment,method,selection,eps,points,vpls,triangles,seed,seconds,pixels,\
-         mean_triplets,accuracy,rmse,bias,bias_se,capped\n",
+         mean_triplets,accuracy,rmse,bias,bias_se,capped,floored\n",
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.scene,
             r.experiment,
             r.method,
@@ -1032,7 +1035,8 @@ fn csv(rows: &[Row]) -> String {
             csv_num(Some(r.rmse)),
             csv_num(Some(r.bias)),
             csv_num(Some(r.bias_se)),
-            r.capped
+            r.capped,
+            r.floored
         );
     }
     s
@@ -1615,6 +1619,7 @@ fn report(
             let trip = rs.iter().map(|x| x.mean_triplets).sum::<f64>() / rs.len() as f64;
             let rmse = rs.iter().map(|x| x.rmse).sum::<f64>() / rs.len() as f64;
             let capped: u64 = rs.iter().map(|x| x.capped).sum();
+            let floored: u64 = rs.iter().map(|x| x.floored).sum();
             let mut row = vec![
                 (*name).to_string(),
                 format!("{} %", 100.0 * eps),
@@ -1628,6 +1633,7 @@ fn report(
                 md_num(Some(secs), 3),
                 md_num(Some(rmse), 3),
                 capped.to_string(),
+                floored.to_string(),
                 format!("{} %", md_num(Some(100.0 * med / eps), 2)),
                 format!("{} %", md_num(Some(100.0 * calibrated(r, eps)), 3)),
             ];
@@ -1660,6 +1666,7 @@ fn report(
             "seconds (subset)",
             "RMSE",
             "capped",
+            "at the floor",
             "median ref. SE / ε",
             "calibrated",
             "goal 93–97 %",
@@ -2003,6 +2010,7 @@ mod tests {
             bias: 0.0,
             bias_se: 0.0,
             capped: 0,
+            floored: 0,
         };
         let (r1, r2) = (row(1.0, 30), row(0.5, 10));
         let (a, se, n) = pooled(&[&r1, &r2]);
@@ -2037,6 +2045,7 @@ mod tests {
             bias: 0.0,
             bias_se: 0.0,
             capped: 0,
+            floored: 0,
         };
         let mut rows = vec![
             row(OURS, "accuracy", 0.05, 0, 1, 0.5, 0.04),
