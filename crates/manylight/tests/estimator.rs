@@ -467,3 +467,29 @@ fn the_effective_degrees_of_freedom_match_hand_worked_cases() {
     // Rounding past J is clamped to J.
     assert_eq!(effective_dof(3, 3.0, 2.9), 3);
 }
+
+/// At a fixed triplet count the two choices of ν see the same samples: the values agree bit
+/// for bit, and Satterthwaite's interval is never narrower (ν_eff ≤ J), strictly wider on
+/// this scene, whose triplets' variances are far from equal.
+#[test]
+fn satterthwaite_widens_the_interval_and_nothing_else() {
+    let s = scene();
+    let mut st = Settings::new(G_MAX);
+    st.epsilon = 0.0;
+    st.max_triplets = 200;
+    let plain = estimator(&s, st);
+    st.dof = Dof::Satterthwaite;
+    let wide = estimator(&s, st);
+    let v = vis();
+    let mut wider = 0;
+    for seed in 0..20 {
+        let a = plain.estimate(&s.shading, &v, pixel_seed(13, seed));
+        let b = wide.estimate(&s.shading, &v, pixel_seed(13, seed));
+        assert_eq!((a.rgb, a.value, a.triplets), (b.rgb, b.value, b.triplets));
+        assert!(b.delta >= a.delta, "seed {seed}");
+        // Both report the same standard error: ΔI over their own t quantile.
+        assert!((a.std_error - b.std_error).abs() <= 1e-12 * a.std_error.max(1e-300));
+        wider += usize::from(b.delta > 1.01 * a.delta);
+    }
+    assert!(wider >= 15, "{wider} of 20 wider");
+}
