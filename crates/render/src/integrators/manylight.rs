@@ -139,7 +139,7 @@ pub const OPTIONS: [OptionSpec; 9] = [
         name: "dark-floor",
         value_name: "F",
         default: "1e-6",
-        help: "Pixels darker than F times the frame's bright level (a 64-pixel pilot's 90th percentile) stop at an absolute error of eps * F * that level instead of eps times their own value; 0: the paper's purely relative criterion",
+        help: "Pixels darker than F times the frame's bright level (the 90th percentile of a 32-pixel pilot at eps 0.2) stop at an absolute error of eps * F * that level instead of eps times their own value; 0: the paper's purely relative criterion",
         kind: OptionKind::Value,
         values: &[],
     },
