@@ -30,7 +30,10 @@
 //! difference goes the other way), for 1.00–1.20× the triplets on six scenes and 4.7 / 2.6 /
 //! 1.35 / 1.13× on the quad-lit head. Two-sample variances make Σ s_j⁴ noisy, so ν_eff errs
 //! low and over-refines at loose ε; ν = J already scores what a calibrated interval scores
-//! against this reference at ε ≥ 2 %, so it stays the default.
+//! against this reference at ε ≥ 2 %, so it stays the default. A triplet whose bound M_j is
+//! 0 (its clusters face away from each other, see [`crate::bounds`]) is an exact 0, not a
+//! sampled stratum: it is not sampled, not refined, and not counted in J for ν or for
+//! `min_triplets`.
 //!
 //! # Refinement
 //!
@@ -191,7 +194,8 @@ impl Settings {
     /// ε = 2 %, BSSRDF-aware selection, the given G clamp, 200 000 triplets and 200 000 splits
     /// per pixel (at most about 110 MB, see [`Settings::peak_pixel_bytes`]; the pixels 2
     /// diffusion lengths deep in the shadow of the `slab` scene need 144 000 of each at
-    /// ε = 2 %), at least 8 triplets, a fresh final estimate, the standard-error interval.
+    /// ε = 2 %), at least 8 triplets, a fresh final estimate, the standard-error interval
+    /// with ν = J, no absolute floor.
     pub fn new(g_max: f64) -> Settings {
         Settings {
             epsilon: 0.02,
