@@ -10,6 +10,8 @@
 //! - `cargo xtask tables`: regenerates the `mc-table` model's Monte Carlo table
 //!   (`crates/bssrdf/data/mc_table.bin`, see [`tables`]).
 
+#![forbid(unsafe_code)]
+
 mod check_results;
 mod compare;
 mod fuzz;

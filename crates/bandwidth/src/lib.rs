@@ -61,6 +61,7 @@
 //!   mixed Voronoi areas of M. Meyer, M. Desbrun, P. Schröder, A. Barr, *Discrete
 //!   Differential-Geometry Operators for Triangulated 2-Manifolds*, VisMath 2002.
 
+#![forbid(unsafe_code)]
 // `!(x > 0.0)` rejects NaN along with non-positive values; clippy's `x <= 0.0` would let NaN
 // through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

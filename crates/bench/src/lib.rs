@@ -15,6 +15,8 @@
 //! None of its own: it times the models of `sss-bssrdf` (Jensen et al. 2001, d'Eon 2012,
 //! Frisvad et al. 2014, Habel et al. 2013).
 
+#![forbid(unsafe_code)]
+
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 

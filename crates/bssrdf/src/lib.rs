@@ -48,6 +48,7 @@
 //!   of light transport*, Appl. Opt. 32(4), 1993 ([`monte_carlo::condensed`]) as the
 //!   `mc-table` model ([`McTableModel`]).
 
+#![forbid(unsafe_code)]
 // `!(x > 0.0)` is how this crate rejects NaN along with non-positive values; clippy's
 // suggestion `x <= 0.0` would let NaN through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -21,6 +21,8 @@
 //! Frisvad et al. 2014, Habel et al. 2013), their Monte Carlo reference (MCML, Wang et al.
 //! 1995), the renderer `sss-render` and the separable kernels of Jimenez et al. 2015.
 
+#![forbid(unsafe_code)]
+
 pub mod args;
 pub mod commands;
 pub mod medium_spec;

@@ -72,6 +72,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+#![forbid(unsafe_code)]
+
 #[cfg(doc)]
 use sss_separable::NO_OBJECT;
 use sss_separable::screen_space::FilterOptions;

@@ -74,6 +74,8 @@
 //!   radius and the point count comes from the random-sequential-adsorption jamming
 //!   density of disks (≈ 0.547, Feder 1980). See [`blue_noise`] for details.
 
+#![forbid(unsafe_code)]
+
 pub mod blue_noise;
 mod bvh;
 pub mod irradiance_tree;

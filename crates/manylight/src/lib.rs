@@ -78,6 +78,8 @@
 //!   scene 86–98 %, lowest at 1 % (21–30 estimates each, ± 5–8 %) and on the point-lit head
 //!   (85.7–92.4 %, where 9–12 of about 100 estimates stop at the triplet cap).
 
+#![forbid(unsafe_code)]
+
 //! ## Example
 //!
 //! ```

@@ -32,6 +32,8 @@
 //! ## Papers
 //! None; the error-map colour ramp samples the inferno map (van der Walt & Smith, matplotlib).
 
+#![forbid(unsafe_code)]
+
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;

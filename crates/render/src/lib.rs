@@ -58,6 +58,7 @@
 //! - The models of `sss-bssrdf` (Jensen et al. 2001, d'Eon 2012, Frisvad et al. 2014, Habel et
 //!   al. 2013).
 
+#![forbid(unsafe_code)]
 // `!(x > 0.0)` is the NaN-rejecting comparison used throughout the numerical code.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 // Colour loops index several [f64; 3] arrays in step (`for c in 0..3`).

@@ -31,6 +31,8 @@
 //! None of its own; the bumpy-sphere displacement and noise textures use Perlin's improved noise
 //! (Perlin 2002), the material presets come from Jensen et al. 2001 (via `sss-bssrdf`).
 
+#![forbid(unsafe_code)]
+
 mod format;
 mod load;
 mod shapes;

@@ -7,3 +7,5 @@
 //! sets; the root workspace has it as a member and the bindings depend on it, so both resolve
 //! to the same set; `xtask`, which `cargo xtask` builds alone, depends on it for the same
 //! reason. Nothing else should depend on it.
+
+#![forbid(unsafe_code)]

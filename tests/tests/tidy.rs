@@ -1,0 +1,97 @@
+//! Rules of the workspace's layout that a compiler does not check.
+
+use std::path::{Path, PathBuf};
+
+/// The workspace root (this crate lives in `tests/`).
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ has a parent")
+        .to_path_buf()
+}
+
+/// Every `.rs` file under `dir`, recursively.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// Whether `text` uses the `unsafe` keyword outside comments (a block, fn, impl or trait).
+fn uses_unsafe(text: &str) -> bool {
+    text.lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .any(|l| {
+            l.split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .any(|w| w == "unsafe")
+        })
+}
+
+/// Crates whose sources hold no `unsafe` forbid it in every target root (`src/lib.rs`,
+/// `src/main.rs`), so that none creeps in unreviewed. The Python bindings are the one
+/// exception: PyO3's macros expand to `unsafe` code inside the crate, which the lint would
+/// refuse.
+#[test]
+fn crates_without_unsafe_code_forbid_it() {
+    let root = root();
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("crates"))
+        .expect("crates/ exists")
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.join("Cargo.toml").is_file())
+        .collect();
+    dirs.push(root.join("xtask"));
+    dirs.sort();
+    let mut missing = Vec::new();
+    let mut checked = 0;
+    for dir in &dirs {
+        if dir.file_name().is_some_and(|n| n == "python") {
+            continue;
+        }
+        let mut files = Vec::new();
+        rust_files(&dir.join("src"), &mut files);
+        let has_unsafe = files
+            .iter()
+            .any(|f| uses_unsafe(&std::fs::read_to_string(f).unwrap_or_default()));
+        if has_unsafe {
+            continue;
+        }
+        for target in ["src/lib.rs", "src/main.rs"] {
+            let f = dir.join(target);
+            let Ok(text) = std::fs::read_to_string(&f) else {
+                continue;
+            };
+            checked += 1;
+            if !text.contains("#![forbid(unsafe_code)]") {
+                missing.push(f.strip_prefix(&root).unwrap_or(&f).display().to_string());
+            }
+        }
+    }
+    assert!(
+        checked >= 10,
+        "only {checked} target roots found under {}",
+        root.display()
+    );
+    assert!(
+        missing.is_empty(),
+        "without `#![forbid(unsafe_code)]`: {}",
+        missing.join(", ")
+    );
+}
+
+#[test]
+fn the_unsafe_scan_reads_code_not_comments_or_names() {
+    assert!(uses_unsafe("    unsafe { x }"));
+    assert!(uses_unsafe("pub unsafe fn f() {}"));
+    assert!(!uses_unsafe("// an unsafe remark"));
+    assert!(!uses_unsafe("#![forbid(unsafe_code)]"));
+    assert!(!uses_unsafe("let not_unsafe = 1;"));
+}
