@@ -95,3 +95,41 @@ fn the_unsafe_scan_reads_code_not_comments_or_names() {
     assert!(!uses_unsafe("#![forbid(unsafe_code)]"));
     assert!(!uses_unsafe("let not_unsafe = 1;"));
 }
+
+/// Every member of the workspace inherits its lints (`[lints] workspace = true`), so a lint
+/// allowed or denied for the workspace is allowed or denied once, in the root `Cargo.toml`.
+#[test]
+fn every_member_inherits_the_workspace_lints() {
+    let root = root();
+    let manifest = std::fs::read_to_string(root.join("Cargo.toml")).expect("root Cargo.toml");
+    assert!(
+        manifest.contains("[workspace.lints"),
+        "no [workspace.lints] table"
+    );
+    let members = manifest
+        .split("members = [")
+        .nth(1)
+        .and_then(|s| s.split(']').next())
+        .expect("a members list");
+    let mut missing = Vec::new();
+    let mut n = 0;
+    for m in members.split(',').map(|s| s.trim().trim_matches('"')) {
+        if m.is_empty() {
+            continue;
+        }
+        n += 1;
+        let text = std::fs::read_to_string(root.join(m).join("Cargo.toml")).unwrap_or_default();
+        let inherits = text
+            .split("[lints]")
+            .nth(1)
+            .is_some_and(|rest| rest.trim_start().starts_with("workspace = true"));
+        if !inherits {
+            missing.push(m.to_string());
+        }
+    }
+    assert!(n >= 10, "only {n} members read");
+    assert!(
+        missing.is_empty(),
+        "not inheriting the workspace lints: {missing:?}"
+    );
+}

@@ -62,9 +62,6 @@
 //!   Differential-Geometry Operators for Triangulated 2-Manifolds*, VisMath 2002.
 
 #![forbid(unsafe_code)]
-// `!(x > 0.0)` rejects NaN along with non-positive values; clippy's `x <= 0.0` would let NaN
-// through.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod angular;
 pub mod curvature;

@@ -49,9 +49,6 @@
 //!   `mc-table` model ([`McTableModel`]).
 
 #![forbid(unsafe_code)]
-// `!(x > 0.0)` is how this crate rejects NaN along with non-positive values; clippy's
-// suggestion `x <= 0.0` would let NaN through.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod better_dipole;
 pub mod catmull_rom;

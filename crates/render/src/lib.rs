@@ -59,10 +59,6 @@
 //!   al. 2013).
 
 #![forbid(unsafe_code)]
-// `!(x > 0.0)` is the NaN-rejecting comparison used throughout the numerical code.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-// Colour loops index several [f64; 3] arrays in step (`for c in 0..3`).
-#![allow(clippy::needless_range_loop)]
 
 pub mod budget;
 pub mod camera;

@@ -7,8 +7,6 @@
 //! intersections, Fresnel equations, Lambert's polygon formula); the code under test is only
 //! called to produce the value being checked.
 
-#![allow(clippy::needless_range_loop)]
-
 use glam::DVec3;
 use sss_bssrdf::{Medium, ModelKind, make_model};
 use sss_render::gbuffer::{GBuffer, GSample};

@@ -5,8 +5,6 @@
 //! each sample's R_d averaged over its own disk it is close. Both figures are printed; the
 //! point-value sum is recomputed here over the same irradiance samples.
 
-#![allow(clippy::needless_range_loop)]
-
 use rayon::prelude::*;
 use sss_bssrdf::{ModelKind, Rgb};
 use sss_render::frame::Frame;

@@ -1,8 +1,6 @@
 //! End-to-end tests of the two references on scenes built in code: the flat-slab closed form,
 //! agreement of `pathtrace` with `exact`, determinism, and the irradiance samples' invariants.
 
-#![allow(clippy::needless_range_loop)]
-
 use glam::DVec3;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{Medium, ModelKind, fresnel_normalization, make_model};

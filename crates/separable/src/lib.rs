@@ -77,11 +77,6 @@
 //!   Skin.* ACM TAP 6(4), 2009 — the screen-space formulation (kernel width from the
 //!   projected pixel size, depth-aware taps).
 
-// `!(x > 0.0)` rejects NaN along with non-positive values; clippy's `x <= 0.0` would not.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-// Loops over RGB channels and grid indices address several parallel arrays at once
-// (`mass[c]`, `total[c]`, `target[c]`); index loops read clearer there than zipped iterators.
-#![allow(clippy::needless_range_loop)]
 #![warn(missing_docs)]
 
 pub mod artist;

@@ -1,9 +1,6 @@
 //! Every kernel conserves energy: its weights sum (in 2D) to the model's total diffuse
 //! reflectance per channel, or to 1 with `Energy::Unit`.
 
-// Index loops over RGB channels read clearer than zipped iterators here.
-#![allow(clippy::needless_range_loop)]
-
 mod common;
 
 use sss_separable::gaussians;

@@ -1,9 +1,6 @@
 //! The fitted models: d'Eon et al.'s sum of Gaussians and the artist-friendly two-Gaussian
 //! model with the paper's Table 2 presets.
 
-// Index loops over RGB channels read clearer than zipped iterators here.
-#![allow(clippy::needless_range_loop)]
-
 mod common;
 
 use sss_separable::artist::{self, ArtistParams};

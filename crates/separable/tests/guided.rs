@@ -1,8 +1,5 @@
 //! Guided optimisation (Jimenez et al. 2015, Appendix A, Eq. 7–8).
 
-// Index loops over RGB channels read clearer than zipped iterators here.
-#![allow(clippy::needless_range_loop)]
-
 mod common;
 
 use sss_separable::guided::{self, GuidedOptions, GuidedResult};

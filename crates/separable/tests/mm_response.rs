@@ -4,8 +4,6 @@
 //! is fractional. The expected image is written here from the taps alone (no helper of the
 //! crate), so a wrong mm → pixel conversion (say offsets scaled by 1.25) fails.
 
-#![allow(clippy::needless_range_loop)]
-
 use sss_separable::screen_space::{FilterOptions, filter};
 use sss_separable::{Kernel1d, ScreenInput, SeparableKernel, SeparableTerm, Tap};
 

@@ -1,9 +1,6 @@
 //! The pre-integrated kernel (Jimenez et al. 2015, §4, Eq. 4–5) is exact for additively
 //! separable irradiance, E(x, y) = E₁(x) + E₂(y).
 
-// Index loops over RGB channels read clearer than zipped iterators here.
-#![allow(clippy::needless_range_loop)]
-
 mod common;
 
 use sss_separable::screen_space::{self, FilterOptions};

@@ -1,8 +1,5 @@
 //! The screen-space filter: silhouettes, jitter, footprint, determinism, bad input.
 
-// Index loops over RGB channels read clearer than zipped iterators here.
-#![allow(clippy::needless_range_loop)]
-
 mod common;
 
 use common::Frame;

@@ -1,9 +1,6 @@
 //! SVD low-rank kernels (Jimenez et al. 2015, §3): exact reconstruction at full rank and the
 //! Eckart–Young error of every truncation.
 
-// Index loops over RGB channels read clearer than zipped iterators here.
-#![allow(clippy::needless_range_loop)]
-
 mod common;
 
 use sss_separable::{TapPlacement, svd};

@@ -1,9 +1,6 @@
 //! Importance-sampled taps (Jimenez et al. 2015, §6 and Figure 11): 7 taps from the dominant
 //! channel's CDF are closer to a 513-tap uniform reference than 7 uniform taps.
 
-// Index loops over RGB channels read clearer than zipped iterators here.
-#![allow(clippy::needless_range_loop)]
-
 mod common;
 
 use sss_separable::screen_space::{self, FilterOptions};
