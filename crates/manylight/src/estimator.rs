@@ -589,7 +589,11 @@ impl<'a> Estimator<'a> {
             }
         }
         let sums = exact_sums(&triplets);
-        let delta = self.delta(sums.bounded, sums.s2, sums.s4);
+        let nu = self.dof(sums.bounded, sums.s2, sums.s4);
+        let delta = self
+            .settings
+            .interval
+            .half_width(self.t, sums.bounded, nu, sums.s2);
         let zero_variance = triplets
             .iter()
             .filter(|t| t.live && t.m > 0.0 && t.s2 == 0.0)
@@ -599,7 +603,7 @@ impl<'a> Estimator<'a> {
             value: sums.value,
             delta,
             std_error: if sums.bounded > 0 {
-                delta / self.t.quantile(self.dof(sums.bounded, sums.s2, sums.s4))
+                delta / self.t.quantile(nu)
             } else {
                 0.0
             },

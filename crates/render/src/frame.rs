@@ -132,6 +132,20 @@ impl Frame<'_> {
         self.shading[self.scene.objects[object as usize].material].as_ref()
     }
 
+    /// The pixels with at least one G-buffer sample on a visible translucent object, in
+    /// increasing order: the pixels with translucent coverage
+    /// ([`crate::render::RenderOutput::translucent_pixels`] of a render of this frame).
+    pub fn translucent_pixels(&self) -> Vec<usize> {
+        let gb = &self.gbuffer;
+        (0..gb.pixels())
+            .filter(|&i| {
+                gb.pixel(i)
+                    .iter()
+                    .any(|g| self.shading_of(g.object).is_some())
+            })
+            .collect()
+    }
+
     /// The irradiance samples of the visible translucent objects for `settings`: placed and lit
     /// on the first request (timed as stage `samples`), then shared by later requests with the
     /// same settings. A request with other settings builds (and keeps) a new set.

@@ -196,14 +196,7 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
 /// the pixels with translucent coverage ([`crate::render::RenderOutput::translucent_pixels`]
 /// of a render of the same frame), in increasing order.
 pub fn translucent_pixels(frame: &Frame<'_>) -> Vec<usize> {
-    let gb = &frame.gbuffer;
-    (0..gb.pixels())
-        .filter(|&i| {
-            gb.pixel(i)
-                .iter()
-                .any(|g| frame.shading_of(g.object).is_some())
-        })
-        .collect()
+    frame.translucent_pixels()
 }
 
 /// The subsurface values that `exact` with `irradiance` gives the pixels `pixels` of `frame`,

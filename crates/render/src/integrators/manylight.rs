@@ -678,15 +678,8 @@ impl ManyLight {
                 pilot.max_triplets = PILOT_MAX_TRIPLETS.min(settings.max_triplets);
                 pilot.min_triplets = pilot.min_triplets.min(pilot.max_triplets);
                 let est = estimators(pilot)?;
-                let translucent: Vec<usize> = (0..gb.pixels())
-                    .filter(|&i| {
-                        gb.pixel(i)
-                            .iter()
-                            .any(|g| est.get(g.object as usize).is_some_and(Option::is_some))
-                    })
-                    .collect();
                 let chosen = crate::metrics::subset_pixels(
-                    &translucent,
+                    &frame.translucent_pixels(),
                     PILOT_PIXELS,
                     frame.seed ^ PILOT_SEED,
                 );
@@ -696,11 +689,15 @@ impl ManyLight {
                         || Refinements::new(max_splits),
                         |refs, &i| {
                             shade(&est, PILOT_SEED, refs, i).map(|o| {
-                                let sum = o
-                                    .values
-                                    .iter()
-                                    .fold([0.0; 3], |a, v| [a[0] + v[0], a[1] + v[1], a[2] + v[2]]);
-                                sss_manylight::profile::luminance(sum) / spp
+                                let px = pixel_result(
+                                    frame,
+                                    i,
+                                    &o.values,
+                                    o.std_error,
+                                    o.triplets,
+                                    o.summary,
+                                );
+                                sss_manylight::luminance(px.subsurface)
                             })
                         },
                     )
