@@ -133,3 +133,103 @@ fn every_member_inherits_the_workspace_lints() {
         "not inheriting the workspace lints: {missing:?}"
     );
 }
+
+/// The module names of the paths in `code` that start at `super::` or `integrators::` (comments
+/// stripped): every identifier of each such path, braces included, so `super::{a, b::c}` gives
+/// `a`, `b`, `c`.
+fn integrator_path_names(code: &str) -> Vec<String> {
+    let code: String = code
+        .lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let mut names = Vec::new();
+    for start in ["super::", "integrators::"] {
+        let mut from = 0;
+        while let Some(i) = code[from..].find(start) {
+            let begin = from + i + start.len();
+            // The path runs over identifiers, `::` and balanced braces.
+            let mut depth = 0usize;
+            let mut end = begin;
+            for (k, c) in code[begin..].char_indices() {
+                let ok = c.is_alphanumeric()
+                    || c == '_'
+                    || c == ':'
+                    || c == '{'
+                    || (depth > 0 && (c == '}' || c == ',' || c.is_whitespace()));
+                if !ok {
+                    break;
+                }
+                match c {
+                    '{' => depth += 1,
+                    '}' => depth -= 1,
+                    _ => {}
+                }
+                end = begin + k + c.len_utf8();
+            }
+            names.extend(
+                code[begin..end]
+                    .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                    .filter(|w| !w.is_empty())
+                    .map(str::to_string),
+            );
+            from = begin;
+        }
+    }
+    names
+}
+
+/// The render crate's integrators keep their shared code above them (the family's `mod.rs`,
+/// `integrators/mod.rs`, `options.rs`, or a crate module): a method file that imported from a
+/// sibling method would make one method's change silently another's, as option specs shared by
+/// array position once did.
+#[test]
+fn no_method_file_imports_from_a_sibling_method() {
+    let dir = root().join("crates/render/src/integrators");
+    let mut files = Vec::new();
+    rust_files(&dir, &mut files);
+    let stem = |p: &Path| p.file_stem().unwrap().to_string_lossy().into_owned();
+    let methods: Vec<PathBuf> = files
+        .into_iter()
+        .filter(|p| !matches!(stem(p).as_str(), "mod" | "options"))
+        .collect();
+    let names: Vec<String> = methods.iter().map(|p| stem(p)).collect();
+    assert!(
+        names.len() >= 9,
+        "expected the nine method files under {}, found {names:?}",
+        dir.display()
+    );
+    let mut offences = Vec::new();
+    for p in &methods {
+        let own = stem(p);
+        let text = std::fs::read_to_string(p).unwrap();
+        for n in integrator_path_names(&text) {
+            if n != own && names.contains(&n) {
+                offences.push(format!("{} names `{n}`", p.display()));
+            }
+        }
+    }
+    offences.sort();
+    offences.dedup();
+    assert!(
+        offences.is_empty(),
+        "method files import from sibling methods (move the shared code into the family's \
+         mod.rs or options.rs):\n{}",
+        offences.join("\n")
+    );
+}
+
+#[test]
+fn the_path_scan_sees_groups_and_chains_but_not_comments() {
+    let names = integrator_path_names(
+        "use super::{Counts, exact::Exact};\nuse crate::integrators::vpl::manylight;\n\
+         // super::dual_tree in a comment\nlet x = super::super::mdlc::f();",
+    );
+    for want in ["Counts", "exact", "Exact", "vpl", "manylight", "mdlc"] {
+        assert!(
+            names.iter().any(|n| n == want),
+            "{want} missing from {names:?}"
+        );
+    }
+    assert!(!names.iter().any(|n| n == "dual_tree"), "{names:?}");
+}

@@ -1,7 +1,7 @@
 //! `cargo xtask check-results DIR`: checks the values in a `compare` run's `results.csv`, not
 //! only that the file exists. CI runs it after `cargo xtask compare --quick`.
 //!
-//! What must hold, from the physics and the conventions (README, `results.csv`):
+//! What must hold, from the physics and the conventions (`docs/compare.md`, `results.csv`):
 //! - every error figure is finite and non-negative, fractions lie in [0, 1], and no run gave
 //!   a warning (the built-in scenes are within every cap);
 //! - the same run with all threads and with one thread has identical error figures (renders

@@ -524,7 +524,7 @@ fn separable(c: &mut Criterion) {
             }
         }
     }
-    // How much of each frame takes the row-chunked fast path (printed for the README).
+    // How much of each frame takes the row-chunked fast path (printed for `docs/benchmarks.md`).
     for (name, f) in [("tilted", &tilted), ("close-up", &closeup)] {
         let fast = screen_space::filter_into_with(
             &f.input(),

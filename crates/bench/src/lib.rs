@@ -157,7 +157,7 @@ mod tests {
             .mm_per_pixel
             .iter()
             .fold((f32::MAX, 0.0f32), |(a, b), &m| (a.min(m), b.max(m)));
-        // The close-up range, 0.05-0.1 mm a pixel: 0.06 at the centre, 1/cos θ out.
+        // The close-up range, 0.05-0.1 mm a pixel: 0.06 at the centre, 1/cos θ out.
         assert!(
             (lo - 0.06).abs() < 1e-4 && hi > 0.085 && hi < 0.09,
             "{lo} {hi}"

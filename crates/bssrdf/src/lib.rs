@@ -62,6 +62,7 @@ mod medium;
 pub mod monte_carlo;
 pub mod photon_beam_diffusion;
 pub mod presets;
+pub mod profile_table;
 pub mod quadrature;
 pub mod radial;
 pub mod spline_row;
@@ -81,8 +82,9 @@ pub use medium::Medium;
 pub use photon_beam_diffusion::PhotonBeamDiffusion;
 pub use standard_dipole::StandardDipole;
 
-/// Three linear colour channels (red, green, blue).
-pub type Rgb = [f64; 3];
+/// Three linear colour channels (red, green, blue): `sss-util`'s, the one colour type of the
+/// toolkit.
+pub use sss_util::Rgb;
 
 /// A point on the boundary of a translucent object with its unit normal, pointing out of the
 /// medium.

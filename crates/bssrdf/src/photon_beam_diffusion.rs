@@ -16,9 +16,9 @@
     reason = "`!(x > 0.0)` deliberately treats NaN as failing the guard"
 )]
 
-use crate::catmull_rom::{apply_weights, catmull_rom_weights, integrate_catmull_rom};
 use crate::fresnel::{fr_dielectric, fresnel_moment1, fresnel_moment2};
-use crate::spline_row::{KnotIndex, OpticalProfile, SplineRow};
+use crate::profile_table::ProfileTable;
+use crate::spline_row::{OpticalProfile, SplineRow};
 use crate::{Bssrdf, Medium, ModelKind, Rgb};
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -156,20 +156,24 @@ pub fn beam_diffusion_ss(sigma_s: f64, sigma_a: f64, g: f64, eta: f64, r: f64) -
 /// (i, j) is 2π r_j (SS + MS)(r_j) for σ_t = 1, σ_s = ρ_i. The effective albedo of each row
 /// and its running integral come from [`integrate_catmull_rom`] over the radii, so they
 /// describe exactly the spline that [`crate::catmull_rom::sample_catmull_rom_2d`] samples.
+/// The table itself is the toolkit's one [`ProfileTable`], which this dereferences to.
+///
+/// Its [`ProfileTable::effective_albedo`] is non-decreasing in ρ (tested for g ∈ {−0.9, 0,
+/// 0.9} × η ∈ {0.75, 1, 1.0001, 1.33, 1.5, 2.5}). Near ρ = 1 the unclamped value exceeds 1 for
+/// g ≤ 0 (PBD adds single scattering on top of a multiple-scattering term that alone is
+/// ≈ 0.95: ρ_eff(1) ≈ 1.08 for g = 0, η = 1; 1.02 for η = 1.33; 1.38 for g = −0.9), so the
+/// clamped curve is flat at 1 over the last few albedo rows there. For g = 0.9 the table's
+/// ≈ 204 mean free paths are only ≈ 20 reduced ones and ρ_eff(1) is truncated (0.86 at η = 1,
+/// 0.56 at η = 2.5, against ≈ 0.99 untruncated).
 #[derive(Clone, Debug)]
-pub struct PbdTable {
-    g: f64,
-    eta: f64,
-    rho_samples: Vec<f64>,
-    radius_samples: Vec<f64>,
-    /// Row-major N_RHO × N_RADIUS values of 2πr (SS + MS).
-    profile: Vec<f64>,
-    /// Row-major running integrals of the profile splines.
-    profile_cdf: Vec<f64>,
-    /// ρ_eff per albedo row: total of the profile spline (pbrt Eq. 11.11).
-    rho_eff: Vec<f64>,
-    /// Constant-time interval lookup over the radius nodes.
-    index: KnotIndex,
+pub struct PbdTable(ProfileTable);
+
+impl std::ops::Deref for PbdTable {
+    type Target = ProfileTable;
+
+    fn deref(&self) -> &ProfileTable {
+        &self.0
+    }
 }
 
 impl PbdTable {
@@ -186,10 +190,10 @@ impl PbdTable {
             .map(|i| (1.0 - (-8.0 * i as f64 / (N_RHO - 1) as f64).exp()) / denom)
             .collect();
         let (c1, c2) = internal_moments(eta);
-        let rows: Vec<(Vec<f64>, Vec<f64>, f64)> = rho_samples
+        let rows: Vec<Vec<f64>> = rho_samples
             .par_iter()
             .map(|&rho| {
-                let row: Vec<f64> = radius_samples
+                radius_samples
                     .iter()
                     .map(|&r| {
                         let sigma_a = (1.0 - rho).max(0.0);
@@ -200,30 +204,14 @@ impl PbdTable {
                                 + ms_with_moments(rho, sigma_a, g, c1, c2, r));
                         if v.is_finite() { v } else { 0.0 }
                     })
-                    .collect();
-                let (total, cdf) = integrate_catmull_rom(&radius_samples, &row);
-                (row, cdf, total)
+                    .collect()
             })
             .collect();
-        let mut profile = Vec::with_capacity(N_RHO * N_RADIUS);
-        let mut profile_cdf = Vec::with_capacity(N_RHO * N_RADIUS);
-        let mut rho_eff = Vec::with_capacity(N_RHO);
-        for (row, cdf, total) in rows {
-            profile.extend(row);
-            profile_cdf.extend(cdf);
-            rho_eff.push(total);
-        }
-        let index = KnotIndex::new(&radius_samples).expect("the PBD radius grid is increasing");
-        PbdTable {
-            g,
-            eta,
-            rho_samples,
-            radius_samples,
-            profile,
-            profile_cdf,
-            rho_eff,
-            index,
-        }
+        let profile: Vec<f64> = rows.into_iter().flatten().collect();
+        PbdTable(
+            ProfileTable::new(g, eta, rho_samples, radius_samples, profile)
+                .expect("the PBD radius grid is increasing and the table full"),
+        )
     }
 
     /// The table for (g, η) from a process-wide cache keyed by their bit patterns, building
@@ -241,92 +229,6 @@ impl PbdTable {
         let table = Arc::new(PbdTable::new(g, eta));
         let mut map = cache.lock().unwrap_or_else(|e| e.into_inner());
         Arc::clone(map.entry(key).or_insert(table))
-    }
-
-    /// Henyey-Greenstein anisotropy of the table.
-    pub fn g(&self) -> f64 {
-        self.g
-    }
-
-    /// Relative index of refraction of the table.
-    pub fn eta(&self) -> f64 {
-        self.eta
-    }
-
-    /// The albedo nodes ρ_i.
-    pub fn rho_samples(&self) -> &[f64] {
-        &self.rho_samples
-    }
-
-    /// The optical radius nodes r_j (units of mean free paths 1/σ_t).
-    pub fn radius_samples(&self) -> &[f64] {
-        &self.radius_samples
-    }
-
-    /// Largest tabulated optical radius; the profile is 0 beyond it.
-    pub fn max_optical_radius(&self) -> f64 {
-        self.radius_samples[N_RADIUS - 1]
-    }
-
-    /// The tabulated value 2π r_j (SS + MS)(r_j) at albedo row `i`, radius column `j`.
-    pub fn profile(&self, i: usize, j: usize) -> f64 {
-        self.profile[i * N_RADIUS + j]
-    }
-
-    /// Row-major [`N_RHO`] × [`N_RADIUS`] array of all profile values.
-    pub fn profile_values(&self) -> &[f64] {
-        &self.profile
-    }
-
-    /// Row-major [`N_RHO`] × [`N_RADIUS`] running integrals of the profile splines (each row
-    /// from [`integrate_catmull_rom`]).
-    pub fn profile_cdf_values(&self) -> &[f64] {
-        &self.profile_cdf
-    }
-
-    /// The effective albedo ρ_eff of every albedo row (integral of the row's spline).
-    pub fn rho_eff_samples(&self) -> &[f64] {
-        &self.rho_eff
-    }
-
-    /// Spline-interpolated effective albedo ρ_eff(ρ) (pbrt Eq. 11.11 interpolated as in
-    /// `TabulatedBSSRDF`), unclamped; 0 outside [0, 1].
-    fn effective_albedo_raw(&self, rho: f64) -> f64 {
-        match catmull_rom_weights(&self.rho_samples, rho) {
-            Some((offset, w)) => apply_weights(offset, &w, |i| self.rho_eff[i]),
-            None => 0.0,
-        }
-    }
-
-    /// The total diffuse reflectance (effective albedo) of a medium with single-scattering
-    /// albedo `rho`, Catmull-Rom interpolated over the albedo rows and clamped to [0, 1];
-    /// 0 for `rho` outside [0, 1].
-    ///
-    /// Non-decreasing in `rho` (tested for g ∈ {−0.9, 0, 0.9} × η ∈ {0.75, 1, 1.0001, 1.33,
-    /// 1.5, 2.5}). Near ρ = 1 the unclamped value exceeds 1 for g ≤ 0 (PBD adds single
-    /// scattering on top of a multiple-scattering term that alone is ≈ 0.95: ρ_eff(1) ≈ 1.08
-    /// for g = 0, η = 1; 1.02 for η = 1.33; 1.38 for g = −0.9), so the clamped curve is flat
-    /// at 1 over the last few albedo rows there. For g = 0.9 the table's ≈ 204 mean free paths
-    /// are only ≈ 20 reduced ones and ρ_eff(1) is truncated (0.86 at η = 1, 0.56 at η = 2.5,
-    /// against ≈ 0.99 untruncated).
-    pub fn effective_albedo(&self, rho: f64) -> f64 {
-        let v = self.effective_albedo_raw(rho);
-        if v.is_finite() {
-            v.clamp(0.0, 1.0)
-        } else {
-            0.0
-        }
-    }
-
-    /// Tensor-product spline interpolation of 2πr (SS + MS) at albedo `rho` and optical radius
-    /// `r_optical` (pbrt §11.4.2 `TabulatedBSSRDF::Sr`), or `None` outside the table. May be
-    /// slightly negative where the spline overshoots.
-    pub fn interpolate_profile(&self, rho: f64, r_optical: f64) -> Option<f64> {
-        let (ro, rw) = catmull_rom_weights(&self.rho_samples, rho)?;
-        let (co, cw) = catmull_rom_weights(&self.radius_samples, r_optical)?;
-        Some(apply_weights(ro, &rw, |i| {
-            apply_weights(co, &cw, |j| self.profile[i * N_RADIUS + j])
-        }))
     }
 }
 
@@ -369,10 +271,10 @@ impl PhotonBeamDiffusion {
         let sigma_t: Rgb = std::array::from_fn(|ch| medium.sigma_t(ch));
         let rows = std::array::from_fn(|ch| {
             SplineRow::blend(
-                &table.index,
-                &table.rho_samples,
-                &table.profile,
-                &table.profile_cdf,
+                table.index(),
+                table.rho_samples(),
+                table.profile_values(),
+                table.profile_cdf_values(),
                 rho[ch],
             )
         });

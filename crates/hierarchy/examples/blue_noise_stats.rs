@@ -8,7 +8,7 @@ use std::time::Instant;
 use glam::DVec3;
 use sss_hierarchy::blue_noise_on_mesh;
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/integration/common/mod.rs"]
 mod common;
 
 fn report(name: &str, tris: &[[DVec3; 3]], radius: f64, max_count: usize) {

@@ -11,7 +11,7 @@ use glam::DVec3;
 use rand::RngExt;
 use sss_hierarchy::{TriangleBvh, blue_noise_on_mesh};
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/integration/common/mod.rs"]
 mod common;
 
 fn best_of<T>(mut f: impl FnMut() -> T) -> (f64, T) {

@@ -14,6 +14,7 @@
 
 use crate::kdtree::{KdNode, KdTree};
 use glam::DVec3;
+use sss_util::LUMINANCE;
 
 /// One irradiance sample, as the tree needs it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,9 +37,6 @@ pub struct IrradianceCluster {
     /// Irradiance-weighted mean position (area-weighted if the node is dark).
     pub position: DVec3,
 }
-
-/// Luminance weights (Rec. 709), for the representative position only.
-const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
 
 /// A kd-tree over irradiance samples with per-node [`IrradianceCluster`]s.
 #[derive(Clone, Debug)]

@@ -55,7 +55,7 @@ fn main() -> Result<(), Error> {
             tris.push([a, a + w + 1, a + w]);
         }
     }
-    let surface = IrradianceTree::new(&pos, &tris)?;
+    let surface = TriangleClusterTree::new(&pos, &tris)?;
 
     // A 0.4 × 0.4 area light at height 0.6, facing down, stratified into VPLs of equal power.
     let side = (n_vpls as f64).sqrt().ceil() as usize;

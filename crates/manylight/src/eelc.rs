@@ -161,23 +161,23 @@ fn exact_sums(pairs: &[Pair]) -> Sums {
 
 /// The EELC estimator for the pixels of one translucent object. `Sync`.
 #[derive(Debug)]
-pub struct Eelc<'a> {
+pub struct EelcEstimator<'a> {
     lights: &'a LightTree,
     ft: &'a Transmittance,
     t: &'a StudentT,
     settings: EelcSettings,
 }
 
-impl<'a> Eelc<'a> {
+impl<'a> EelcEstimator<'a> {
     /// Checks the settings and bundles the shared data.
     pub fn new(
         lights: &'a LightTree,
         ft: &'a Transmittance,
         t: &'a StudentT,
         settings: EelcSettings,
-    ) -> Result<Eelc<'a>, Error> {
+    ) -> Result<EelcEstimator<'a>, Error> {
         settings.validate()?;
-        Ok(Eelc {
+        Ok(EelcEstimator {
             lights,
             ft,
             t,

@@ -97,7 +97,7 @@ use glam::DVec3;
 use crate::Error;
 use crate::bounds::{self, ClusterKind, Selection};
 use crate::confidence::StudentT;
-use crate::irradiance_cluster::{IcId, IrradianceTree, Refinements};
+use crate::irradiance_cluster::{IcId, Refinements, TriangleClusterTree};
 use crate::profile::{RadialProfile, Transmittance, luminance};
 use crate::shading_cluster::ShadingTree;
 use crate::vpl::LightTree;
@@ -332,7 +332,7 @@ impl PixelEstimate {
 #[derive(Debug)]
 pub struct Estimator<'a> {
     lights: &'a LightTree,
-    surface: &'a IrradianceTree,
+    surface: &'a TriangleClusterTree,
     profile: &'a RadialProfile,
     ft: &'a Transmittance,
     t: &'a StudentT,
@@ -436,7 +436,7 @@ impl<'a> Estimator<'a> {
     /// Checks the settings and bundles the shared data.
     pub fn new(
         lights: &'a LightTree,
-        surface: &'a IrradianceTree,
+        surface: &'a TriangleClusterTree,
         profile: &'a RadialProfile,
         ft: &'a Transmittance,
         t: &'a StudentT,

@@ -41,7 +41,7 @@ use crate::Error;
 use crate::aabb::Aabb;
 use crate::binary_tree::{descend, median_split};
 use crate::cone::NormalCone;
-use crate::irradiance_cluster::IrradianceTree;
+use crate::irradiance_cluster::TriangleClusterTree;
 use crate::profile::{RadialProfile, luminance};
 use crate::shading_cluster::ShadingPoint;
 
@@ -114,7 +114,7 @@ pub fn gather_points(
 /// proportion to its area, then a uniform point on it: density 1/A, Nabata & Iwasaki Eq. 7 over
 /// the whole mesh), each with area weight A/n; `next` gives uniforms in [0, 1) (three per point).
 pub fn uniform_points(
-    surface: &IrradianceTree,
+    surface: &TriangleClusterTree,
     n: usize,
     next: &mut impl FnMut() -> f64,
     out: &mut Vec<IrradiancePoint>,

@@ -15,7 +15,7 @@
 //! at ε = 1 % (0.9905 at ε = 0.1 %, 96²), while with the mesh's normals replaced by its face
 //! normals in every method the two agreed within 0.07 %; on an icosahedron with radial vertex
 //! normals it was 7.6 % above the path trace. With the interpolated normals the dragon's ratio
-//! to `exact` is 1.0000–1.0006 and the icosahedron's to the path trace 0.998–1.0006. [`IrradianceTree::with_normals`] keeps the vertex
+//! to `exact` is 1.0000–1.0006 and the icosahedron's to the path trace 0.998–1.0006. [`TriangleClusterTree::with_normals`] keeps the vertex
 //! normals; [`Triangle::halve`] gives the new vertex the average of its edge's two (not
 //! normalised), so the halves interpolate exactly as their parent did; a cluster's normal cone
 //! holds every interpolated normal of its triangles. A light reaches a point only where it is
@@ -202,7 +202,7 @@ impl Triangle {
     }
 }
 
-/// A node of the [`IrradianceTree`].
+/// A node of the [`TriangleClusterTree`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IcNode {
     /// Box of the triangles below.
@@ -211,7 +211,7 @@ pub struct IcNode {
     pub area: f64,
     /// Children, or `None` for a leaf of one triangle.
     pub children: Option<[u32; 2]>,
-    /// The triangle of a leaf (index into [`IrradianceTree::triangles`]).
+    /// The triangle of a leaf (index into [`TriangleClusterTree::triangles`]).
     pub triangle: u32,
     /// A cone holding the normals of the triangles below (`None` when all are degenerate).
     pub cone: Option<NormalCone>,
@@ -221,7 +221,7 @@ pub struct IcNode {
 /// centroids along the longest axis. Shared by all pixels (`Send + Sync`); refinement lives in
 /// [`Refinements`].
 #[derive(Clone, Debug)]
-pub struct IrradianceTree {
+pub struct TriangleClusterTree {
     triangles: Vec<Triangle>,
     nodes: Vec<IcNode>,
 }
@@ -229,29 +229,29 @@ pub struct IrradianceTree {
 /// An irradiance cluster: a node of the shared tree or a triangle of a pixel's refinement arena.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum IcId {
-    /// A node of the [`IrradianceTree`].
+    /// A node of the [`TriangleClusterTree`].
     Base(u32),
     /// A split triangle in a [`Refinements`] arena.
     Split(u32),
 }
 
-impl IrradianceTree {
+impl TriangleClusterTree {
     /// Builds the BVH of a mesh of flat triangles (each point's normal is its triangle's).
     /// Errors: no triangles, an index out of range, a non-finite position, or zero total area.
     /// Degenerate triangles are kept (area 0: never sampled).
-    pub fn new(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<IrradianceTree, Error> {
-        IrradianceTree::build(positions, None, triangles)
+    pub fn new(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<TriangleClusterTree, Error> {
+        TriangleClusterTree::build(positions, None, triangles)
     }
 
     /// Builds the BVH of a mesh with a shading normal per vertex (`normals[k]` at
     /// `positions[k]`), interpolated over each triangle (see the module documentation). Errors
-    /// as [`IrradianceTree::new`], and a normal count other than the position count. A normal
+    /// as [`TriangleClusterTree::new`], and a normal count other than the position count. A normal
     /// that is zero or not finite is replaced by its triangle's own normal.
     pub fn with_normals(
         positions: &[DVec3],
         normals: &[DVec3],
         triangles: &[[u32; 3]],
-    ) -> Result<IrradianceTree, Error> {
+    ) -> Result<TriangleClusterTree, Error> {
         if normals.len() != positions.len() {
             return Err(Error::InvalidInput(format!(
                 "{} normals for {} vertices",
@@ -259,14 +259,14 @@ impl IrradianceTree {
                 positions.len()
             )));
         }
-        IrradianceTree::build(positions, Some(normals), triangles)
+        TriangleClusterTree::build(positions, Some(normals), triangles)
     }
 
     fn build(
         positions: &[DVec3],
         normals: Option<&[DVec3]>,
         triangles: &[[u32; 3]],
-    ) -> Result<IrradianceTree, Error> {
+    ) -> Result<TriangleClusterTree, Error> {
         if triangles.is_empty() {
             return Err(Error::InvalidInput("mesh without triangles".into()));
         }
@@ -327,7 +327,7 @@ impl IrradianceTree {
                 },
             },
         );
-        Ok(IrradianceTree {
+        Ok(TriangleClusterTree {
             triangles: tris,
             nodes,
         })
@@ -380,7 +380,7 @@ pub struct SplitNode {
     pub children: Option<[u32; 2]>,
 }
 
-/// Per-pixel refinement of an [`IrradianceTree`]: the halves of split triangles, in a growable
+/// Per-pixel refinement of a [`TriangleClusterTree`]: the halves of split triangles, in a growable
 /// arena. A triangle split once is reused by every triplet that splits it again, so the
 /// clusters of a pixel always tile the mesh: no triangle is lost or counted twice.
 ///
@@ -439,7 +439,7 @@ impl Refinements {
     }
 
     /// Area A_j of a cluster.
-    pub fn area(&self, tree: &IrradianceTree, id: IcId) -> f64 {
+    pub fn area(&self, tree: &TriangleClusterTree, id: IcId) -> f64 {
         match id {
             IcId::Base(n) => tree.nodes[n as usize].area,
             IcId::Split(k) => self.nodes[k as usize].triangle.area,
@@ -447,7 +447,7 @@ impl Refinements {
     }
 
     /// Box of a cluster.
-    pub fn bbox(&self, tree: &IrradianceTree, id: IcId) -> Aabb {
+    pub fn bbox(&self, tree: &TriangleClusterTree, id: IcId) -> Aabb {
         match id {
             IcId::Base(n) => tree.nodes[n as usize].bbox,
             IcId::Split(k) => self.nodes[k as usize].bbox,
@@ -455,7 +455,7 @@ impl Refinements {
     }
 
     /// The normal cone of a cluster (`None`: no non-degenerate triangle).
-    pub fn cone(&self, tree: &IrradianceTree, id: IcId) -> Option<NormalCone> {
+    pub fn cone(&self, tree: &TriangleClusterTree, id: IcId) -> Option<NormalCone> {
         match id {
             IcId::Base(n) => tree.nodes[n as usize].cone,
             IcId::Split(k) => self.nodes[k as usize].triangle.cone(),
@@ -463,7 +463,7 @@ impl Refinements {
     }
 
     /// True if the cluster is one triangle (a BVH leaf or an arena triangle).
-    pub fn is_single_triangle(&self, tree: &IrradianceTree, id: IcId) -> bool {
+    pub fn is_single_triangle(&self, tree: &TriangleClusterTree, id: IcId) -> bool {
         match id {
             IcId::Base(n) => tree.nodes[n as usize].children.is_none(),
             IcId::Split(_) => true,
@@ -472,7 +472,7 @@ impl Refinements {
 
     /// True if [`Refinements::split`] would succeed without a new split (an inner BVH node, or
     /// a triangle split before) or with one under the cap.
-    pub fn can_split(&self, tree: &IrradianceTree, id: IcId) -> bool {
+    pub fn can_split(&self, tree: &TriangleClusterTree, id: IcId) -> bool {
         match id {
             IcId::Base(n) => {
                 tree.nodes[n as usize].children.is_some()
@@ -488,7 +488,7 @@ impl Refinements {
     /// The two halves of a cluster: the BVH children of an inner node, or the two triangles
     /// from halving the longest edge of a single triangle (made once, then reused). `None` when
     /// a new split is needed and the cap is reached (counted in [`Refinements::cap_hits`]).
-    pub fn split(&mut self, tree: &IrradianceTree, id: IcId) -> Option<[IcId; 2]> {
+    pub fn split(&mut self, tree: &TriangleClusterTree, id: IcId) -> Option<[IcId; 2]> {
         match id {
             IcId::Base(n) => {
                 let node = &tree.nodes[n as usize];
@@ -535,7 +535,7 @@ impl Refinements {
     /// Samples a point uniformly (density 1/A_j, Eq. 7) in a cluster from three uniforms:
     /// a triangle in proportion to area (descending the BVH), then a uniform point on it, with
     /// its shading and geometric normals.
-    pub fn sample(&self, tree: &IrradianceTree, id: IcId, u: [f64; 3]) -> SurfaceSample {
+    pub fn sample(&self, tree: &TriangleClusterTree, id: IcId, u: [f64; 3]) -> SurfaceSample {
         let tri = match id {
             IcId::Split(k) => &self.nodes[k as usize].triangle,
             IcId::Base(n) => {

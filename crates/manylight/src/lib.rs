@@ -43,7 +43,7 @@
 //! 1/length², areas in length²); intensities in W/sr; the result is in the units of
 //! `w · R_d · I · G · A`, i.e. radiance when the weights carry 1/π and the exit Fresnel factor.
 //!
-//! **One object at a time.** An [`IrradianceTree`] is one translucent mesh; a pixel whose
+//! **One object at a time.** A [`TriangleClusterTree`] is one translucent mesh; a pixel whose
 //! shading points lie on several objects is estimated once per object with that object's
 //! points, and the results are added.
 //!
@@ -88,7 +88,7 @@
 //!
 //! // A 1 × 1 square (two triangles, normal +z), lit by one point light 1 above its centre.
 //! let pos = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
-//! let surface = IrradianceTree::new(&pos, &[[0, 1, 2], [0, 2, 3]])?;
+//! let surface = TriangleClusterTree::new(&pos, &[[0, 1, 2], [0, 2, 3]])?;
 //! let lights = LightTree::new(vec![Vpl::point(DVec3::new(0.5, 0.5, 1.0), [1.0; 3])])?;
 //! // An exponential profile (non-increasing: checked) and F_t = 1.
 //! let profile = RadialProfile::new(|r| [(-4.0 * r).exp(); 3], 2.0)?;
@@ -133,7 +133,7 @@ pub mod vpl;
 pub use aabb::{Aabb, Sphere};
 pub use bounds::{ClusterKind, Selection};
 pub use confidence::StudentT;
-pub use eelc::{Eelc, EelcSettings};
+pub use eelc::{EelcEstimator, EelcSettings};
 pub use estimator::{
     Dof, Estimator, Interval, PixelEstimate, Settings, Status, Visibility, effective_dof,
     pixel_seed,
@@ -141,8 +141,8 @@ pub use estimator::{
 pub use gather_tree::{
     GatherNode, GatherPoint, GatherTree, IrradiancePoint, gather_points, uniform_points,
 };
-pub use irradiance_cluster::{IcId, IrradianceTree, Refinements, SurfaceSample, Triangle};
-pub use mdlc::{CutPair, Mdlc, MdlcSettings};
+pub use irradiance_cluster::{IcId, Refinements, SurfaceSample, Triangle, TriangleClusterTree};
+pub use mdlc::{CutPair, MdlcCut, MdlcSettings};
 pub use profile::{LUMINANCE, RadialProfile, Transmittance, luminance};
 pub use shading_cluster::{ShadingPoint, ShadingTree};
 pub use summary::Summary;
@@ -174,13 +174,13 @@ mod send_sync {
     #[test]
     fn shared_data_is_send_and_sync() {
         assert_send_sync::<crate::LightTree>();
-        assert_send_sync::<crate::IrradianceTree>();
+        assert_send_sync::<crate::TriangleClusterTree>();
         assert_send_sync::<crate::RadialProfile>();
         assert_send_sync::<crate::Transmittance>();
         assert_send_sync::<crate::StudentT>();
         assert_send_sync::<crate::Estimator<'static>>();
-        assert_send_sync::<crate::Mdlc<'static>>();
-        assert_send_sync::<crate::Eelc<'static>>();
+        assert_send_sync::<crate::MdlcCut<'static>>();
+        assert_send_sync::<crate::EelcEstimator<'static>>();
         assert_send_sync::<crate::GatherTree>();
     }
 }

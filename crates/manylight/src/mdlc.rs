@@ -122,22 +122,22 @@ struct Counters {
 /// The MDLC cut for the pixels of one translucent object: the light tree (with its per-channel
 /// cluster intensities), F_t at the irradiance point and the settings. `Sync`.
 #[derive(Debug)]
-pub struct Mdlc<'a> {
+pub struct MdlcCut<'a> {
     lights: &'a LightTree,
     light_rgb: Vec<[f64; 3]>,
     ft: &'a Transmittance,
     settings: MdlcSettings,
 }
 
-impl<'a> Mdlc<'a> {
+impl<'a> MdlcCut<'a> {
     /// Checks the settings and sums the light tree's RGB intensities.
     pub fn new(
         lights: &'a LightTree,
         ft: &'a Transmittance,
         settings: MdlcSettings,
-    ) -> Result<Mdlc<'a>, Error> {
+    ) -> Result<MdlcCut<'a>, Error> {
         settings.validate()?;
-        Ok(Mdlc {
+        Ok(MdlcCut {
             light_rgb: light_rgb_sums(lights.nodes(), lights.vpls()),
             lights,
             ft,
@@ -157,7 +157,7 @@ impl<'a> Mdlc<'a> {
         self.run(gather, visibility, None)
     }
 
-    /// [`Mdlc::estimate`] and the final cut.
+    /// [`MdlcCut::estimate`] and the final cut.
     pub fn estimate_cut(
         &self,
         gather: &GatherTree,

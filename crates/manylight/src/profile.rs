@@ -4,16 +4,10 @@
 
 use crate::Error;
 
-/// Luminance weights (Rec. 709) used to turn RGB into the scalar that is sampled and
-/// error-controlled: VPLs are picked in proportion to `LUMINANCE · intensity`, and the stopping
-/// rule ΔI < εI is applied to `LUMINANCE · I`.
-pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
-
-/// `LUMINANCE · c`.
-#[inline]
-pub fn luminance(c: [f64; 3]) -> f64 {
-    LUMINANCE[0] * c[0] + LUMINANCE[1] * c[1] + LUMINANCE[2] * c[2]
-}
+/// Luminance weights (Rec. 709, defined in `sss-util`) used to turn RGB into the scalar that
+/// is sampled and error-controlled: VPLs are picked in proportion to `LUMINANCE · intensity`,
+/// and the stopping rule ΔI < εI is applied to `LUMINANCE · I`.
+pub use sss_util::{LUMINANCE, luminance};
 
 type RdFn = dyn Fn(f64) -> [f64; 3] + Send + Sync;
 type FtFn = dyn Fn(f64) -> f64 + Send + Sync;

@@ -1,5 +1,5 @@
 //! Frame-level counts of the per-pixel outcomes, so a renderer can report how many pixels hit
-//! each cap or hazard (the issue asks for the number of pixels that hit a cap).
+//! each cap or hazard (the number of pixels that hit a cap).
 
 use crate::estimator::{PixelEstimate, Status};
 

@@ -13,8 +13,8 @@ use sss_render::Error;
 use sss_render::image::read_exr;
 use sss_render::integrators::{self, MethodOptions};
 use sss_render::metrics::{error_figures, mean_ratio_rgb};
-use sss_render::render::{RenderSettings, render as render_scene};
 use sss_render::scene::{LoadOptions, Scene, load_str};
+use sss_render::{RenderSettings, render as render_scene};
 use std::path::PathBuf;
 
 /// Loads `scene`: TOML text (a str holding a line break), a path (str or os.PathLike) or the

@@ -267,7 +267,7 @@ mod tests {
         assert_eq!(one, 10_000 * (BYTES_PER_SAMPLE + BYTES_PER_PIXEL));
         let four = frame_bytes(100, 100, 4);
         assert_eq!(four - one, 3 * 10_000 * BYTES_PER_SAMPLE);
-        // The example: 100000² pixels is about 10¹⁰ samples, terabytes.
+        // The example: 100000² pixels is about 10¹⁰ samples, terabytes.
         assert!(frame_bytes(100_000, 100_000, 1) > 1u64 << 40);
         assert_eq!(frame_bytes(u32::MAX, u32::MAX, u32::MAX), u64::MAX);
         // A G-buffer sample is a few dozen f64: the estimate is not off by orders.

@@ -54,7 +54,7 @@ impl<'a> Frame<'a> {
     /// Builds the BVHs, casts the camera rays and builds the models of the translucent
     /// materials the camera sees. It allocates for every camera sample: check the frame
     /// against a memory budget first ([`crate::budget::check_frame`], which
-    /// [`crate::render::render`] does).
+    /// [`crate::render`] does).
     pub fn prepare(scene: &'a Scene, seed: u64) -> Frame<'a> {
         let mut stages = Vec::new();
         let geom = timed_into(&mut stages, "bvh", || SceneGeometry::new(scene));
@@ -134,7 +134,7 @@ impl Frame<'_> {
 
     /// The pixels with at least one G-buffer sample on a visible translucent object, in
     /// increasing order: the pixels with translucent coverage
-    /// ([`crate::render::RenderOutput::translucent_pixels`] of a render of this frame).
+    /// ([`crate::pipeline::RenderOutput::translucent_pixels`] of a render of this frame).
     pub fn translucent_pixels(&self) -> Vec<usize> {
         let gb = &self.gbuffer;
         (0..gb.pixels())
@@ -304,4 +304,27 @@ fn timed_into<T>(stages: &mut Vec<Stage>, name: &'static str, f: impl FnOnce() -
         seconds: t.elapsed().as_secs_f64(),
     });
     v
+}
+
+/// A sample's value as a pixel counts it: non-finite or negative values count as 0.
+#[inline]
+pub(crate) fn pixel_value(v: f64) -> f64 {
+    if v.is_finite() && v > 0.0 { v } else { 0.0 }
+}
+
+/// A pixel's subsurface value from its camera samples' values (`None` for samples off
+/// translucent objects, which count 0), exactly as [`crate::render`] assembles it: the sum of each
+/// sample's value over `samples_per_pixel` (misses count 0 too), non-finite or negative
+/// values counting 0. Shared by the
+/// renderer and the methods that shade a subset of pixels (`exact::shade_subset`, the VPL
+/// methods' `shade_pixels`).
+pub fn assembled_subsurface(values: &[Option<Rgb>], samples_per_pixel: u32) -> Rgb {
+    let spp = samples_per_pixel as f64;
+    let mut sss = [0.0; 3];
+    for v in values.iter().flatten() {
+        for c in 0..3 {
+            sss[c] += pixel_value(v[c]) / spp;
+        }
+    }
+    sss
 }

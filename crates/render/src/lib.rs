@@ -2,16 +2,20 @@
 //!
 //! A thin library composing the toolkit's crates behind one integrator interface: ray casting
 //! (one exact BVH per object, `sss-hierarchy`), the G-buffer, direct lighting with shadow rays,
-//! irradiance samples, the [`integrators`] (`exact`, `pathtrace`, `separable`, each one file
-//! under `integrators/`), image output (EXR, PNG) and image [`metrics`]. Use it to render a
-//! scene from code or to add a method; the `sss` binary (crate `sss-cli`) and `cargo xtask
-//! compare` are thin layers over it. It pulls in no CLI, progress-bar or plotting crate:
-//! progress reaches the caller through [`progress::Progress`].
+//! irradiance samples, the [`integrators`] and their registry, image output (EXR, PNG) and
+//! image [`metrics`]. The nine methods come in families (`integrators/`): the point sums
+//! `exact`, `single-tree`, `dual-tree` and `dual-tree-fmm` (sums over irradiance samples,
+//! exactly or through trees); the VPL methods `manylight`, `mdlc` and `eelc` (many-light
+//! estimators over virtual point lights); the `pathtrace` reference; and the screen-space
+//! `separable` pass. Use it to render a scene from code ([`render`]) or to add a method; the
+//! `sss` binary (crate `sss-cli`) and `cargo xtask compare` are thin layers over it. It pulls in
+//! no CLI, progress-bar or plotting crate: progress reaches the caller through
+//! [`progress::Progress`].
 //!
 //! ```
 //! use sss_render::integrators::{self, MethodOptions};
 //! use sss_render::progress::NoProgress;
-//! use sss_render::render::{RenderSettings, render};
+//! use sss_render::{RenderSettings, render};
 //! use sss_render::scene::{LoadOptions, load_str};
 //!
 //! let text = r#"
@@ -49,10 +53,18 @@
 //!
 //! ## Papers
 //! - Jensen & Buhler 2002, *A rapid hierarchical rendering technique for translucent
-//!   materials*: irradiance samples and the point-based sum ([`irradiance`], `exact`).
+//!   materials*: irradiance samples, the point-based sum and the single tree ([`irradiance`],
+//!   `exact`, `single-tree`).
+//! - Milaenen et al. 2019, *Frequency analysis and dual hierarchy for efficient rendering of
+//!   subsurface scattering*: the dual tree with per-pixel sampling rates (`dual-tree`; the
+//!   local-expansion variant `dual-tree-fmm` is this crate's own).
+//! - Nabata & Iwasaki 2021, *Many-light rendering of subsurface scattering with adaptive
+//!   irradiance sampling and error control*: `manylight`, and its baselines Walter et al. 2006
+//!   (multidimensional lightcuts, `mdlc`) and Sakai et al. 2019 (error estimation for
+//!   lightcuts, `eelc`).
 //! - Pharr, Jakob & Humphreys, *Physically Based Rendering* 3rd ed., §11.4 and §15.4: the
 //!   separable BSSRDF S_ω normalisation and BSSRDF importance sampling with probe rays
-//!   (`pathtrace`).
+//!   (`pathtrace`, [`probe`]).
 //! - Jimenez et al. 2015, *Separable Subsurface Scattering*: the screen-space pass
 //!   (`separable`, kernels from `sss-separable`).
 //! - The models of `sss-bssrdf` (Jensen et al. 2001, d'Eon 2012, Frisvad et al. 2014, Habel et
@@ -72,8 +84,9 @@ pub mod irradiance;
 pub mod kernel_choice;
 pub mod lights;
 pub mod metrics;
+pub mod pipeline;
+pub mod probe;
 pub mod progress;
-pub mod render;
 pub mod rng;
 pub mod shading;
 pub mod vpls;
@@ -81,3 +94,7 @@ pub mod vpls;
 pub use error::Error;
 /// The scene format (re-exported from `sss-scene`).
 pub use sss_scene as scene;
+
+pub use pipeline::{
+    RenderOutput, RenderSettings, Stage, assembled_subsurface, check_scene, render,
+};

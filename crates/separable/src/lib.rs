@@ -101,5 +101,6 @@ pub use screen_space::{FilterOptions, FilterScratch, NO_OBJECT, ScreenInput};
 pub use special::{erf, erfc, gaussian_mass};
 pub use taps::TapPlacement;
 
-/// Three linear colour channels (red, green, blue), as in `sss-bssrdf`.
-pub type Rgb = [f64; 3];
+/// Three linear colour channels (red, green, blue): `sss-util`'s, the one colour type of the
+/// toolkit.
+pub use sss_util::Rgb;

@@ -1,7 +1,10 @@
-//! # sss-util: the two utilities every crate of the toolkit shares
+//! # sss-util: the few definitions every crate of the toolkit shares
 //!
-//! Use it when you need the toolkit's seeding or its crash-safe file writes; it has no
-//! dependencies, so depending on it costs nothing.
+//! Use it when you need the toolkit's colour type, its seeding or its crash-safe file writes;
+//! it has no dependencies, so depending on it costs nothing.
+//!
+//! - [`Rgb`], [`LUMINANCE`] and [`luminance`]: three linear colour channels and their Rec. 709
+//!   luminance (ITU-R BT.709-6, Table 3 item 3.3), defined once for every crate.
 //!
 //! - [`splitmix64`] and [`splitmix64_mix`]: the SplitMix64 step and finaliser (Steele, Lea &
 //!   Flood 2014, *Fast splittable pseudorandom number generators*, OOPSLA). Every random stream
@@ -37,6 +40,19 @@ use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Three linear colour channels (red, green, blue).
+pub type Rgb = [f64; 3];
+
+/// Luminance weights of linear Rec. 709 RGB (ITU-R BT.709-6, Table 3 item 3.3): the scalar a
+/// colour is sampled, clustered and error-controlled by.
+pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+/// `LUMINANCE · c`, summed red, green, blue in that order.
+#[inline]
+pub fn luminance(c: Rgb) -> f64 {
+    LUMINANCE[0] * c[0] + LUMINANCE[1] * c[1] + LUMINANCE[2] * c[2]
+}
 
 /// The SplitMix64 golden-ratio increment, ⌊2⁶⁴/φ⌋ (odd).
 pub const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;

@@ -150,7 +150,7 @@ fn world_space(ctx: &Context<'_>) -> Result<Vec<Vec<String>>, Error> {
     use sss_render::integrators::separable::Separable;
     use sss_render::metrics::error_figures;
     use sss_render::progress::NoProgress;
-    use sss_render::render::{RenderSettings, render};
+    use sss_render::{RenderSettings, render};
     // Only the two scenes whose materials the table is about, if the run includes them.
     let names: Vec<String> = ctx
         .config

@@ -40,7 +40,7 @@ pub const TITLE: &str = "Against MCML (independent Monte Carlo)";
 /// The file written next to `profiles.csv`.
 pub const CSV_NAME: &str = "mcml.csv";
 
-/// The header of `mcml.csv` (documented in README.md).
+/// The header of `mcml.csv` (documented in `docs/compare.md`).
 pub const CSV_HEADER: &str = "case,model,model_part,eta,g,reduced_albedo,mfp_mm,near_excess,near_at_mfp,near_rel_error,near_single_excess,near_median_abs_error,far_excess,far_at_mfp,far_rel_error,far_single_excess,total_model,total_mcml,total_mcml_se,total_rel_error,bins,bins_forgiven";
 
 /// The near range, in reduced mean free paths.

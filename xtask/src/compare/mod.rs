@@ -4,7 +4,7 @@
 //!    cache or simulated ([`mod@reference`]).
 //! 2. Each registered [`Experiment`] uses the references and contributes a report
 //!    [`Section`] plus its own files (today: [`profiles::ProfileComparison`], every model's
-//!    radial profile against Monte Carlo; later issues add rendering methods here).
+//!    radial profile against Monte Carlo; the rendering methods follow).
 //! 3. `report.md` is assembled from the sections.
 //!
 //! Everything random is seeded ([`Config::seed`]), so error figures are reproducible; only

@@ -190,7 +190,7 @@ pub fn evaluate(
     out
 }
 
-/// The header of `profiles.csv` (documented in README.md).
+/// The header of `profiles.csv` (documented in `docs/compare.md`).
 pub const CSV_HEADER: &str = "preset,model,channel,rel_l2_error,max_rel_error,total_model,total_mc,total_mc_se,ns_per_eval,build_seconds,mc_part";
 
 /// `profiles.csv`: one row per (preset, model, channel).

@@ -1,4 +1,4 @@
-//! The cached subset reference of a scene (issue 9, "References at real resolution"): `exact`
+//! The cached subset reference of a scene: `exact`
 //! (the [`reference_method`] of the full reference) on a seeded uniform random subset of
 //! [`SUBSET_PIXELS`] pixels with translucent coverage (all of them when there are fewer), so
 //! that renders at 1024² and 2048² can be scored without shading every pixel. The MSE over
@@ -17,16 +17,16 @@ use super::checked::{self, Entry, fnv1a64};
 use super::scenes::reference_method;
 use super::{Context, Error};
 use sss_bssrdf::Rgb;
+use sss_render::RenderSettings;
 use sss_render::frame::Frame;
 use sss_render::integrators::exact::{shade_subset, translucent_pixels};
 use sss_render::metrics::{SubsetError, subset_error, subset_pixels};
-use sss_render::render::RenderSettings;
 use sss_render::scene::Scene;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-/// Pixels in a subset reference (at least 20 000, issue 9).
+/// Pixels in a subset reference (at least 20 000).
 pub const SUBSET_PIXELS: usize = 20_000;
 
 /// Bumped whenever the subset reference's values or file layout change.
@@ -113,7 +113,7 @@ fn compute(
     irradiance: &sss_render::irradiance::IrradianceSettings,
 ) -> Result<SubsetReference, sss_render::Error> {
     let budget = RenderSettings::default().max_memory;
-    sss_render::render::check_scene(scene)?;
+    sss_render::check_scene(scene)?;
     sss_render::budget::check_frame(scene, budget)?;
     sss_render::budget::check_irradiance(scene, irradiance, budget)?;
     let t = Instant::now();
@@ -207,7 +207,7 @@ fn load(path: &Path, image_pixels: usize) -> Result<Option<SubsetReference>, Str
 mod tests {
     use super::*;
     use crate::compare::checked::tests as t;
-    use sss_render::render::render;
+    use sss_render::render;
 
     /// A subset reference of the built-in sphere at 24×18: the stored values equal the full
     /// `exact` render's at the subset pixels (here every pixel, fewer than SUBSET_PIXELS),

@@ -33,8 +33,8 @@ use sss_render::integrators::exact::reference_spacing;
 use sss_render::integrators::single_tree::SingleTree;
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::progress::NoProgress;
-use sss_render::render::{RenderOutput, RenderSettings, render};
 use sss_render::scene::{self, LoadOptions, Scene, SceneErrorKind};
+use sss_render::{RenderOutput, RenderSettings, render};
 use std::fmt::Write as _;
 
 /// The paper-scale bunny: the full-resolution scan (35 947 vertices, in metres) scaled ×64 to

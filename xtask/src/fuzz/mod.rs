@@ -1,4 +1,4 @@
-//! `cargo xtask fuzz`: fuzzing on stable Rust with a seeded mutator (issue 12).
+//! `cargo xtask fuzz`: fuzzing on stable Rust with a seeded mutator.
 //!
 //! Four targets ([`targets::Target`]): `scene` (scene TOML through `sss_scene::load_str` and
 //! `load`), `obj` (a scene naming a mutated OBJ mesh), `exr` (`read_exr` and `sss filter` on

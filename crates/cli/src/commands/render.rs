@@ -8,8 +8,8 @@ use sss_bssrdf::Rgb;
 use sss_render::Error;
 use sss_render::image::{auto_exposure, write_exr, write_png};
 use sss_render::integrators::{self, Integrator, MethodOptions};
-use sss_render::render::{RenderOutput, RenderSettings, render};
 use sss_render::scene::{self, LoadOptions, Scene};
+use sss_render::{RenderOutput, RenderSettings, render};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

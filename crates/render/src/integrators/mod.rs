@@ -16,24 +16,36 @@
 //! extra per-pixel layers. It times its stages with [`Frame::timed`] and reports progress in
 //! G-buffer samples. Same frame seed, same output, for any thread count.
 //!
+//! # Layout
+//! Methods come in families, each with the code its members share in its own `mod.rs`:
+//! - [`point_sums`]: sums over irradiance samples — [`exact`], [`single_tree`], [`dual_tree`],
+//!   [`dual_tree_fmm`] (the illumination tree, the dual trees' shading points and s_p);
+//! - [`vpl`]: many-light methods over virtual point lights — [`manylight`], and under
+//!   [`vpl::gather_points`] (the fixed gather-point pipeline) [`mdlc`] and [`eelc`];
+//! - [`pathtrace`] (its probe sampler is [`crate::probe`], which the gather-point pipeline
+//!   also draws with) and [`separable`] stand alone.
+//!
+//! Option specs more than one method takes are named constants in [`options`]; a method
+//! lists the ones it takes by name. No method file imports from a sibling method file (a
+//! tidy test checks it): shared code lives above the methods that use it. The methods'
+//! modules are re-exported here (`integrators::exact`, `integrators::manylight`, ...).
+//!
 //! # Adding a method
-//! One new file here with the settings type (implementing [`Integrator`]) and a [`Method`]
-//! entry (name, options, constructor, compare sweep), and one line in [`METHODS`]. The `sss
-//! render` flags, the `cargo xtask compare` sweep and the pipeline all read the registry.
+//! One new file in its family (or here, if it stands alone) with the settings type
+//! (implementing [`Integrator`]) and a [`Method`] entry (name, options, constructor, compare
+//! sweep), and one line in [`METHODS`]. The `sss render` flags, the `cargo xtask compare`
+//! sweep and the pipeline all read the registry.
 
-pub mod baseline;
-pub mod dual_tree;
-pub mod dual_tree_fmm;
-pub mod eelc;
-pub mod exact;
-pub mod manylight;
-pub mod mdlc;
 pub mod options;
 pub mod pathtrace;
+pub mod point_sums;
 pub mod separable;
-pub mod single_tree;
+pub mod vpl;
 
 pub use options::{MethodOptions, OptionKind, OptionSpec};
+pub use point_sums::{dual_tree, dual_tree_fmm, exact, single_tree};
+pub use vpl::gather_points::{eelc, mdlc};
+pub use vpl::manylight;
 
 use crate::Error;
 use crate::frame::Frame;
@@ -166,4 +178,14 @@ pub(crate) fn add_scaled(acc: &mut Rgb, v: Rgb, s: f64) {
     for c in 0..3 {
         acc[c] += v[c] * s;
     }
+}
+
+/// Errors unless every visible translucent material is radial.
+pub(crate) fn check_radial(frame: &Frame<'_>, method: &str) -> Result<(), Error> {
+    for &o in &frame.visible {
+        if let Some(sh) = frame.shading_of(o) {
+            sh.radial(method)?;
+        }
+    }
+    Ok(())
 }

@@ -5,6 +5,7 @@
 
 use super::Method;
 use crate::Error;
+use crate::irradiance::IrradianceSettings;
 use std::collections::BTreeMap;
 use std::str::FromStr;
 
@@ -112,6 +113,143 @@ impl MethodOptions {
     pub fn flag(&self, name: &str) -> bool {
         self.values.contains_key(name)
     }
+}
+
+// The option specs more than one method takes, by name: a method lists the ones it takes in
+// its own `OPTIONS`, so reordering one method's flags never rewires another's.
+
+/// `--spacing MFP`: irradiance sample spacing (the point sums: `exact`, `single-tree`,
+/// `dual-tree`, `dual-tree-fmm`).
+pub const SPACING: OptionSpec = OptionSpec {
+    name: "spacing",
+    value_name: "MFP",
+    default: "0.5",
+    help: "Irradiance sample spacing in units of the smallest reduced mean free path",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// `--max-samples N`: the cap on irradiance samples per object (the point sums).
+pub const MAX_SAMPLES: OptionSpec = OptionSpec {
+    name: "max-samples",
+    value_name: "N",
+    default: "100000",
+    help: "At most this many irradiance samples per object (the spacing grows to respect it)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// The irradiance-sample options every point sum takes first: [`SPACING`], [`MAX_SAMPLES`].
+pub const SAMPLE_OPTIONS: [OptionSpec; 2] = [SPACING, MAX_SAMPLES];
+
+/// `--eps E` of the tree traversals (`single-tree`, `dual-tree`, `dual-tree-fmm`): the
+/// solid-angle threshold of Jensen & Buhler 2002 and Milaenen et al. 2019.
+pub const SOLID_ANGLE_EPS: OptionSpec = OptionSpec {
+    name: "eps",
+    value_name: "E",
+    default: "0.05",
+    help: "Solid-angle threshold ε: a node of irradiance samples stands for all of them \
+           when A / d² < ε (smaller is more accurate and slower)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// `--eps E` of the Student-t estimators (`manylight`, `eelc`): the relative error target
+/// of Nabata & Iwasaki.
+pub const RELATIVE_EPS: OptionSpec = OptionSpec {
+    name: "eps",
+    value_name: "E",
+    default: "0.02",
+    help: "Relative error threshold: refine each pixel until its Student-t interval is below E times its value (the paper uses 0.02)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// `--alpha A`: the confidence level of the Student-t interval (`manylight`, `eelc`).
+pub const ALPHA: OptionSpec = OptionSpec {
+    name: "alpha",
+    value_name: "A",
+    default: "0.95",
+    help: "Confidence level of the interval, in (0, 1)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// `--vpls N`: VPLs per quad or environment light (`manylight`, `mdlc`, `eelc`).
+pub const VPLS: OptionSpec = OptionSpec {
+    name: "vpls",
+    value_name: "N",
+    default: "1024",
+    help: "VPLs per quad or environment light (a point or directional light is one VPL)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// `--irradiance-points N` (`mdlc`, `eelc`).
+pub const IRRADIANCE_POINTS: OptionSpec = OptionSpec {
+    name: "irradiance-points",
+    value_name: "N",
+    default: "4096",
+    help: "Irradiance points drawn per shading point before the pixel is estimated (the paper uses 4096)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// `--uniform-points` (`mdlc`, `eelc`).
+pub const UNIFORM_POINTS: OptionSpec = OptionSpec {
+    name: "uniform-points",
+    value_name: "",
+    default: "",
+    help: "Draw the irradiance points uniformly by area over the object instead of by BSSRDF importance sampling (probe rays)",
+    kind: OptionKind::Flag,
+    values: &[],
+};
+
+/// `--max-pairs N` (`mdlc`, `eelc`).
+pub const MAX_PAIRS: OptionSpec = OptionSpec {
+    name: "max-pairs",
+    value_name: "N",
+    default: "200000",
+    help: "Cap on the cluster pairs (gather cluster x light cluster) of one pixel and object (pixels at the cap are counted and warned about)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// Reads and checks the irradiance-sample options ([`SAMPLE_OPTIONS`]).
+pub fn sample_settings(o: &MethodOptions) -> Result<IrradianceSettings, Error> {
+    let spacing: f64 = o.get(&SAMPLE_OPTIONS, "spacing")?;
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Err(Error::Input(format!(
+            "--spacing must be positive, got {spacing}"
+        )));
+    }
+    Ok(IrradianceSettings {
+        spacing_mfp: spacing,
+        max_samples: o.get(&SAMPLE_OPTIONS, "max-samples")?,
+        ..IrradianceSettings::default()
+    })
+}
+
+/// Reads and checks `--eps` of `options` (finite, ≥ 0; every method's ε has that range).
+pub fn eps_option(o: &MethodOptions, options: &[OptionSpec]) -> Result<f64, Error> {
+    let eps: f64 = o.get(options, "eps")?;
+    if !(eps.is_finite() && eps >= 0.0) {
+        return Err(Error::Input(format!(
+            "--eps must be finite and >= 0, got {eps}"
+        )));
+    }
+    Ok(eps)
+}
+
+/// Reads and checks the confidence level `--alpha` of `options` (in (0, 1)).
+pub fn alpha_option(o: &MethodOptions, options: &[OptionSpec]) -> Result<f64, Error> {
+    let alpha: f64 = o.get(options, "alpha")?;
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(Error::Input(format!(
+            "--alpha must be in (0, 1), got {alpha}"
+        )));
+    }
+    Ok(alpha)
 }
 
 #[cfg(test)]

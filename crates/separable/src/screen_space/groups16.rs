@@ -6,7 +6,7 @@
 //! the pixels' sums into RGB order is a few two-register permutes.
 //!
 //! Why: the same frame in one process, 16-pixel groups against 8-pixel ones, was 1.2× as
-//! fast on 2 threads of an AVX-512 Xeon, with and without jitter (README, benchmarks).
+//! fast on 2 threads of an AVX-512 Xeon, with and without jitter (`docs/benchmarks.md`).
 //!
 //! Per group and axis tap, the same steps and f32 operations as the 8-lane loop (so the
 //! same positions, fractions and sums, bit for bit): the pixels' positions, floors and

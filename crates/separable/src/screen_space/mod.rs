@@ -47,13 +47,13 @@
 //! the rotation table and the rotated taps' loads from cells checked inside the image once
 //! per group. The portable loops (`rows.rs`, kept for other CPUs and tested against the same
 //! reference as `Evaluation::RowsBaseline`) keep their sums in memory and, compiled for
-//! AVX2, took 1.2–1.4× the time without jitter on the benchmark frames (README). The
+//! AVX2, took 1.2–1.4× the time without jitter on the benchmark frames (`docs/benchmarks.md`). The
 //! baseline build multiplies and adds separately, so the two builds differ by rounding. Where
 //! the CPU also has AVX-512F, `groups16.rs` runs the same loops on groups of 16 pixels (a
 //! tap's positions and cells for 16 pixels per instruction, two pixels' rotated reads per
 //! register) with the same operations per pixel, so it gives the AVX2 loops' bits exactly
 //! (`Evaluation::RowsAvx2` holds a run to the AVX2 loops, for that test). Cost and its
-//! breakdown: `crates/bench/benches/separable.rs` and the README.
+//! breakdown: `crates/bench/benches/separable.rs` and `docs/benchmarks.md`.
 //!
 //! Output: per pixel, the diffuse exitance E ∗ R_d (with [`crate::Energy::TotalReflectance`]
 //! kernels); the caller applies its Fresnel / π factors. Background pixels

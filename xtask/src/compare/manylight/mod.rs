@@ -64,15 +64,15 @@ use sss_bssrdf::Rgb;
 use sss_manylight::Selection;
 use sss_plot::{PALETTE, Series, SeriesStyle, line_plot, write_error_map};
 use sss_render::frame::Frame;
-use sss_render::integrators::baseline::PointOptions;
 use sss_render::integrators::eelc::Eelc;
 use sss_render::integrators::exact::translucent_pixels;
 use sss_render::integrators::manylight::{ManyLight, PixelResult};
 use sss_render::integrators::mdlc::Mdlc;
+use sss_render::integrators::vpl::gather_points::PointOptions;
 use sss_render::metrics::subset_pixels;
 use sss_render::progress::NoProgress;
-use sss_render::render::{RenderSettings, render};
 use sss_render::scene::{self, Light, LoadOptions, Scene, SceneErrorKind};
+use sss_render::{RenderSettings, render};
 use sss_separable::erf;
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -82,7 +82,7 @@ use std::time::Instant;
 /// direct light only, so one area light's worth).
 pub const VPLS: u32 = 1024;
 
-/// Luminance weights (Rec. 709), as `sss_manylight::LUMINANCE`.
+/// Luminance weights (Rec. 709).
 const LUM: [f64; 3] = sss_manylight::LUMINANCE;
 
 fn lum(c: Rgb) -> f64 {
@@ -1381,7 +1381,7 @@ fn table1(rows: &[Row], refs: &[(&'static str, Reference, usize)], p: &Plan) -> 
     out
 }
 
-/// The goal: at equal quality at least 5× faster than EELC with importance sampling
+/// The goal: at equal quality at least 5× faster than EELC with importance sampling
 /// (the paper: 1.3–12.4×), with the measured figure per scene.
 fn goal_line(rows: &[Row], refs: &[(&'static str, Reference, usize)], p: &Plan) -> String {
     let parts: Vec<String> = refs

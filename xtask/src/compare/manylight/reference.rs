@@ -7,7 +7,7 @@
 //! triangle or light clusters, no bounds, no stopping rule. It estimates the same pixel values:
 //! the same G-buffer (the frame's camera samples, seeded by the run's seed), a pixel's value
 //! the sum of its camera samples' values over the camera samples per pixel, as
-//! `sss_render::render::assembled_subsurface` assembles them. Its one bias is the profile
+//! `sss_render::assembled_subsurface` assembles them. Its one bias is the profile
 //! energy beyond the probe spheres ([`Reference::missed`], at most 1 − the probe energy).
 //!
 //! **No stopping bias.** A pilot of [`Budget::pilot`] paths per camera sample estimates each

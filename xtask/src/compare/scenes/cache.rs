@@ -10,8 +10,8 @@ use sss_render::image::{read_exr, write_exr};
 use sss_render::integrators::exact::{Exact, reference_spacing};
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::progress::NoProgress;
-use sss_render::render::{RenderSettings, render};
 use sss_render::scene::Scene;
+use sss_render::{RenderSettings, render};
 use std::path::Path;
 
 /// Bumped whenever the reference renderer's output (or the cache layout) changes, to

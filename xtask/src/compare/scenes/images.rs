@@ -4,9 +4,9 @@ use super::super::Error;
 use super::EPS;
 use sss_bssrdf::Rgb;
 use sss_plot::write_error_map;
+use sss_render::RenderOutput;
 use sss_render::image::write_png;
 use sss_render::metrics::relative_errors;
-use sss_render::render::RenderOutput;
 use std::path::Path;
 
 /// Writes `<name>.png` (the subsurface image) and `<name>_error.png` (its relative error

@@ -7,7 +7,7 @@
 //! results ([`assemble`]). An unsharded run does all three in one process; `--shard` runs a
 //! share of the units and `--merge` assembles the shards' results (see `super::shard`).
 //!
-//! Writes `results.csv` (one row per run and thread count; columns documented in README.md),
+//! Writes `results.csv` (one row per run and thread count; columns documented in `docs/compare.md`),
 //! `error_vs_time_<scene>.png` (log-log RMSE against total seconds), and under
 //! `scenes/<scene>/` the reference, each method's most expensive render and its false-colour
 //! error map.
@@ -29,11 +29,11 @@ use cache::Reference;
 use images::write_images;
 use runs::{Outcome, csv_rows, run_timed};
 use sss_plot::{PALETTE, Series, SeriesStyle, line_plot};
+use sss_render::RenderSettings;
 use sss_render::image::{auto_exposure, write_png};
 use sss_render::integrators::exact::reference_spacing;
 use sss_render::integrators::{METHODS, MethodOptions};
 use sss_render::metrics::{error_figures, frac_within_se, mean_ratio};
-use sss_render::render::RenderSettings;
 use sss_render::scene::Scene;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -584,7 +584,7 @@ pub(super) fn assemble(
 mod tests {
     use super::super::Config;
     use super::*;
-    use sss_render::render::Stage;
+    use sss_render::Stage;
 
     fn config(out: PathBuf) -> Config {
         Config {

@@ -1,5 +1,5 @@
 //! One timed run of a method, `results.csv` (one row per run and thread count; columns
-//! documented in README.md), and the lossless text records a shard writes of its runs
+//! documented in `docs/compare.md`), and the lossless text records a shard writes of its runs
 //! ([`Run::record`]). The stage columns follow the stages the runs report, in pipeline
 //! order, so a new method's stages get their own columns.
 
@@ -9,8 +9,8 @@ use super::super::output::csv_num;
 use sss_render::integrators::Integrator;
 use sss_render::integrators::METHODS;
 use sss_render::progress::NoProgress;
-use sss_render::render::{RenderOutput, RenderSettings, Stage, render};
 use sss_render::scene::Scene;
+use sss_render::{RenderOutput, RenderSettings, Stage, render};
 use std::fmt::Write as _;
 
 /// Stages every render reports first, in order.
@@ -73,7 +73,7 @@ impl Run {
     }
 }
 
-/// The header of `results.csv` (documented in README.md).
+/// The header of `results.csv` (documented in `docs/compare.md`).
 pub fn csv_header(stages: &[&str]) -> String {
     let mut h = String::from("scene,method,param,value,threads,host,host_cores,seconds_total");
     for s in stages {
@@ -337,7 +337,7 @@ mod tests {
         }
     }
 
-    /// The columns of today's three methods keep the order README documents, and a new
+    /// The columns of today's three methods keep the order `docs/compare.md` documents, and a new
     /// method's stage gets a column before `shading`.
     #[test]
     fn stage_columns_follow_the_pipeline() {

@@ -1,0 +1,208 @@
+//! The `exact` reference: at each shading point, the sum over every irradiance sample of its
+//! object of the model's contribution, with no hierarchy and no culling. Ground truth for the
+//! hierarchical methods (single tree, dual tree, many-light) on the same points: their error
+//! against it is the hierarchy's error alone.
+//!
+//! Each sample's R_d is [`TranslucentShading::rd_sample_scene`]: R_d averaged over the
+//! sample's own disk (its area A_i) near the shading point, where peaked profiles would
+//! otherwise let the nearest sample dominate, and the (corrected) point value far away. So
+//! the sum is a good estimate of the surface integral pixel by pixel, not only on average
+//! (per-pixel agreement with `pathtrace`: `tests/disk_average.rs`).
+//!
+//! [`shade_subset`] computes the same values for a subset of pixels only: a reference at
+//! resolutions where shading every pixel would take too long, scored with
+//! [`crate::metrics::subset_error`].
+
+use crate::Error;
+use crate::frame::Frame;
+use crate::frame::assembled_subsurface;
+use crate::gbuffer::GSample;
+use crate::integrators::options::SAMPLE_OPTIONS;
+use crate::integrators::options::sample_settings;
+use crate::integrators::{Integrator, Method, MethodOptions, Shaded, Stat, Sweep, add_scaled};
+use crate::irradiance::{IrradianceSettings, ObjectSamples};
+use crate::progress::Progress;
+use crate::shading::TranslucentShading;
+use rayon::prelude::*;
+use sss_bssrdf::{Rgb, SurfacePoint};
+
+/// The irradiance-sample spacing (mean free paths) of `cargo xtask compare`'s reference: the
+/// default, or twice it with `--quick`.
+pub fn reference_spacing(quick: bool) -> f64 {
+    let default = IrradianceSettings::default().spacing_mfp;
+    if quick { 2.0 * default } else { default }
+}
+
+/// The registry entry.
+pub const METHOD: Method = Method {
+    name: "exact",
+    about: "Brute-force sum over all irradiance samples",
+    options: &SAMPLE_OPTIONS,
+    build: |o| Ok(Box::new(Exact::from_options(o)?)),
+    sweep: Sweep {
+        option: "spacing",
+        label: "spacing_mfp",
+        // Coarser samples than the reference (×8, ×4, ×2; ×4, ×2 with --quick): how the error
+        // grows as the samples thin out.
+        values: |quick| {
+            let factors: &[f64] = if quick { &[4.0, 2.0] } else { &[8.0, 4.0, 2.0] };
+            factors
+                .iter()
+                .map(|f| f * reference_spacing(quick))
+                .collect()
+        },
+    },
+};
+
+/// The `exact` integrator and its settings.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Exact {
+    /// Irradiance sample placement and lighting.
+    pub irradiance: IrradianceSettings,
+}
+
+impl Exact {
+    /// The settings `options` describe.
+    pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
+        Ok(Exact {
+            irradiance: sample_settings(o)?,
+        })
+    }
+}
+
+impl Integrator for Exact {
+    fn name(&self) -> &'static str {
+        METHOD.name
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "irradiance sample spacing {} mean free paths, at most {} per object",
+            self.irradiance.spacing_mfp, self.irradiance.max_samples
+        )
+    }
+
+    fn irradiance_settings(&self) -> Option<IrradianceSettings> {
+        Some(self.irradiance)
+    }
+
+    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        let samples = frame.irradiance_samples(&self.irradiance);
+        let by_object = frame.samples_by_object(&samples);
+        let values: Vec<Rgb> = frame.timed("shading", || {
+            frame
+                .gbuffer
+                .samples
+                .par_iter()
+                .map(|g| {
+                    let v = match (frame.shading_of(g.object), by_object[g.object as usize]) {
+                        (Some(sh), Some(s)) => shade(g, sh, s),
+                        _ => [0.0; 3],
+                    };
+                    progress.advance(1);
+                    v
+                })
+                .collect()
+        });
+        let evaluations: usize = frame
+            .gbuffer
+            .samples
+            .iter()
+            .filter(|g| frame.shading_of(g.object).is_some())
+            .map(|g| by_object[g.object as usize].map_or(0, |s| s.samples.len()))
+            .sum();
+        Ok(Shaded {
+            values,
+            stats: vec![Stat {
+                name: "sample_pairs",
+                value: evaluations as f64,
+            }],
+            ..Shaded::default()
+        })
+    }
+}
+
+/// The subsurface radiance leaving `g` towards the camera.
+pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples) -> Rgb {
+    let mut sum = [0.0; 3];
+    if shading.directional() {
+        // Full S of the directional dipole, positions in mm.
+        let u = shading.units_per_mm;
+        let model = shading.bssrdf();
+        let xo = SurfacePoint { p: g.p / u, n: g.n };
+        for (i, s) in samples.samples.iter().enumerate() {
+            let xi = SurfacePoint {
+                p: s.position / u,
+                n: s.normal,
+            };
+            let a = s.area / (u * u);
+            for packet in samples.incident_of(i) {
+                let sv = model.s(&xi, packet.dir, &xo, g.wo);
+                for c in 0..3 {
+                    sum[c] += sv[c] * packet.e_cos[c] * a;
+                }
+            }
+        }
+        return sum;
+    }
+    shading.add_point_sum(
+        &mut sum,
+        g.p,
+        samples
+            .samples
+            .iter()
+            .map(|s| (s.position, s.area, s.irradiance)),
+    );
+    let mut out = [0.0; 3];
+    add_scaled(&mut out, sum, shading.exit_weight(g.n, g.wo));
+    out
+}
+
+/// The pixels of `frame` with at least one G-buffer sample on a visible translucent object:
+/// the pixels with translucent coverage ([`crate::pipeline::RenderOutput::translucent_pixels`]
+/// of a render of the same frame), in increasing order.
+pub fn translucent_pixels(frame: &Frame<'_>) -> Vec<usize> {
+    frame.translucent_pixels()
+}
+
+/// The subsurface values that `exact` with `irradiance` gives the pixels `pixels` of `frame`,
+/// assembled as [`crate::render`] assembles them (the mean over the pixel's camera
+/// samples, those off translucent objects counting 0), so equal to the full render's
+/// `subsurface` at those pixels to rounding. Only the listed pixels are shaded; the irradiance
+/// samples are built for every visible translucent object (check their memory first with
+/// [`crate::budget::check_irradiance`]). Shading is timed as stage `shading`. A pixel index
+/// past the image is an error.
+pub fn shade_subset(
+    frame: &Frame<'_>,
+    irradiance: &IrradianceSettings,
+    pixels: &[usize],
+) -> Result<Vec<Rgb>, Error> {
+    let n = frame.gbuffer.pixels();
+    if let Some(&bad) = pixels.iter().find(|&&i| i >= n) {
+        return Err(Error::Input(format!(
+            "subset reference: pixel {bad} is past the image's {n} pixels"
+        )));
+    }
+    let samples = frame.irradiance_samples(irradiance);
+    let by_object = frame.samples_by_object(&samples);
+    let gb = &frame.gbuffer;
+    Ok(frame.timed("shading", || {
+        pixels
+            .par_iter()
+            .map(|&i| {
+                let values: Vec<Option<Rgb>> = gb
+                    .pixel(i)
+                    .iter()
+                    .map(
+                        |g| match (frame.shading_of(g.object), by_object[g.object as usize]) {
+                            (Some(sh), Some(s)) => Some(shade(g, sh, s)),
+                            (Some(_), None) => Some([0.0; 3]),
+                            _ => None,
+                        },
+                    )
+                    .collect();
+                assembled_subsurface(&values, gb.samples_per_pixel)
+            })
+            .collect()
+    }))
+}

@@ -1,0 +1,171 @@
+//! The single-tree traversal of Jensen & Buhler 2002 ("A rapid hierarchical rendering
+//! technique for translucent materials", §4), as Algorithm 1 of Milaenen et al. 2019 states
+//! it: at every shading point x_o, walk a kd-tree over the object's irradiance samples
+//! ([`IrradianceTree`]) and let a node stand for all its samples when it subtends a small
+//! solid angle, Δω = A_I / ‖x_o − p_I‖² < ε, and x_o is outside its bounding box.
+//!
+//! The contribution of an accepted node is R_d(‖x_o − p_I‖) Σ E_i A_i (its flux at its
+//! irradiance-weighted position); a leaf that is not accepted adds its samples one by one,
+//! exactly as [`super::exact`] does (the same [`TranslucentShading::rd_sample_scene`]). So at
+//! ε → 0 the traversal equals `exact` over the same samples to rounding, and its error
+//! against `exact` is the hierarchy's error alone. The test is applied to leaves too (as in
+//! Mitsuba's `irrtree`): a distant leaf is one evaluation, not `leaf` evaluations.
+//!
+//! Radial models only (a node's flux is summed without incident directions): the directional
+//! dipole is refused with an error naming the material.
+
+use super::{
+    Counts, accepts, add_samples, eps_sweep, illumination_tree_bytes, illumination_trees, inside,
+    rd_times,
+};
+use crate::Error;
+use crate::frame::Frame;
+use crate::integrators::options::{
+    MAX_SAMPLES, SOLID_ANGLE_EPS, SPACING, eps_option, sample_settings,
+};
+use crate::integrators::{
+    Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep, add_scaled, check_radial,
+};
+use crate::irradiance::IrradianceSettings;
+use crate::progress::Progress;
+use crate::shading::TranslucentShading;
+use glam::DVec3;
+use rayon::prelude::*;
+use sss_bssrdf::Rgb;
+use sss_hierarchy::IrradianceTree;
+use sss_scene::Scene;
+
+/// The options: the irradiance-sample options and ε.
+pub const OPTIONS: [OptionSpec; 3] = [SPACING, MAX_SAMPLES, SOLID_ANGLE_EPS];
+
+/// The registry entry.
+pub const METHOD: Method = Method {
+    name: "single-tree",
+    about: "Jensen & Buhler 2002 hierarchical point sum (one tree over irradiance samples)",
+    options: &OPTIONS,
+    build: |o| Ok(Box::new(SingleTree::from_options(o)?)),
+    sweep: Sweep {
+        option: "eps",
+        label: "eps",
+        values: eps_sweep,
+    },
+};
+
+/// The `single-tree` integrator and its settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SingleTree {
+    /// Irradiance sample placement and lighting.
+    pub irradiance: IrradianceSettings,
+    /// The solid-angle threshold ε.
+    pub eps: f64,
+}
+
+impl Default for SingleTree {
+    fn default() -> Self {
+        SingleTree {
+            irradiance: IrradianceSettings::default(),
+            eps: 0.05,
+        }
+    }
+}
+
+impl SingleTree {
+    /// The settings `options` describe.
+    pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
+        Ok(SingleTree {
+            irradiance: sample_settings(o)?,
+            eps: eps_option(o, &OPTIONS)?,
+        })
+    }
+}
+
+/// The sum at `x` over the tree, by Algorithm 1 (before the exit weight).
+pub(crate) fn single(
+    tree: &IrradianceTree,
+    x: DVec3,
+    eps: f64,
+    sh: &TranslucentShading,
+    counts: &Counts,
+) -> Rgb {
+    let mut acc = [0.0; 3];
+    if tree.tree.nodes.is_empty() {
+        return acc;
+    }
+    let (mut visits, mut clusters, mut singles) = (0u64, 0u64, 0u64);
+    let mut stack: Vec<u32> = Vec::with_capacity(64);
+    stack.push(0);
+    while let Some(k) = stack.pop() {
+        visits += 1;
+        let node = &tree.tree.nodes[k as usize];
+        let cl = &tree.clusters[k as usize];
+        let d2 = (cl.position - x).length_squared();
+        if accepts(cl.area, d2, eps) && !inside(node, x) {
+            let rd = sh.rd_sample_scene(d2.sqrt(), cl.area);
+            add_scaled(&mut acc, rd_times(rd, cl.flux), 1.0);
+            clusters += 1;
+        } else if node.is_leaf() {
+            let points = tree.points_of(node);
+            add_samples(&mut acc, points, x, sh);
+            singles += points.len() as u64;
+        } else {
+            // Right first, so the left subtree is summed first.
+            stack.push(node.right);
+            stack.push(node.left);
+        }
+    }
+    counts.add(visits, clusters, singles);
+    acc
+}
+
+impl Integrator for SingleTree {
+    fn name(&self) -> &'static str {
+        METHOD.name
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "ε = {}, irradiance sample spacing {} mean free paths, at most {} per object",
+            self.eps, self.irradiance.spacing_mfp, self.irradiance.max_samples
+        )
+    }
+
+    fn irradiance_settings(&self) -> Option<IrradianceSettings> {
+        Some(self.irradiance)
+    }
+
+    fn structure_bytes(&self, _scene: &Scene, samples: &[(usize, u64, u64)]) -> u64 {
+        illumination_tree_bytes(samples)
+    }
+
+    fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        check_radial(frame, METHOD.name)?;
+        let samples = frame.irradiance_samples(&self.irradiance);
+        let trees = frame.timed("illumination_tree", || illumination_trees(frame, &samples));
+        let counts = Counts::default();
+        let values: Vec<Rgb> = frame.timed("shading", || {
+            frame
+                .gbuffer
+                .samples
+                .par_iter()
+                .map(|g| {
+                    let v = match (frame.shading_of(g.object), &trees[g.object as usize]) {
+                        (Some(sh), Some(t)) => {
+                            let sum = single(t, g.p, self.eps, sh, &counts);
+                            let mut out = [0.0; 3];
+                            add_scaled(&mut out, sum, sh.exit_weight(g.n, g.wo));
+                            out
+                        }
+                        _ => [0.0; 3],
+                    };
+                    progress.advance(1);
+                    v
+                })
+                .collect()
+        });
+        Ok(Shaded {
+            values,
+            stats: counts.stats("nodes_visited"),
+            ..Shaded::default()
+        })
+    }
+}

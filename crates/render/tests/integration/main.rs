@@ -1,0 +1,23 @@
+//! The integration tests of `sss-render`, one module per file, linked into one test binary:
+//! each binary links the whole dependency graph, so one per crate instead of one per file
+//! saves most of the suite's link time. Run one file's tests with
+//! `cargo test -p sss-render --test integration <module>::`.
+
+mod bounded_resources;
+mod closed_forms;
+mod common;
+mod disk_average;
+mod dual_tree_fmm;
+mod exr_budget;
+mod fuzz_regressions;
+mod integrator_contract;
+mod manylight;
+mod metrics_by_hand;
+mod pathological_geometry;
+mod pathtrace_bias;
+mod ray_casting;
+mod render;
+mod scene_framing;
+mod separable_fast_path;
+mod subset_reference;
+mod trees;

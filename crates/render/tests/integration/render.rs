@@ -1,0 +1,375 @@
+//! End-to-end tests of the two references on scenes built in code: the flat-slab closed form,
+//! agreement of `pathtrace` with `exact`, determinism, and the irradiance samples' invariants.
+
+use glam::DVec3;
+use sss_bssrdf::fresnel::ft_dielectric;
+use sss_bssrdf::{Medium, ModelKind, fresnel_normalization, make_model};
+use sss_render::geometry::SceneGeometry;
+use sss_render::integrators::Integrator;
+use sss_render::integrators::exact::Exact;
+use sss_render::integrators::pathtrace::PathTrace;
+use sss_render::irradiance::{self, IrradianceSettings};
+use sss_render::progress::NoProgress;
+use sss_render::scene::{Camera, Light, Material, MaterialKind, Mesh, Object, Scene, Translucent};
+use sss_render::{RenderOutput, RenderSettings, render};
+use std::f64::consts::PI;
+
+/// A UV sphere of `rings` × `segments` quads, outward normals.
+fn uv_sphere(centre: DVec3, radius: f64, rings: u32, segments: u32) -> Mesh {
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    for i in 0..=rings {
+        let theta = PI * i as f64 / rings as f64;
+        for j in 0..segments {
+            let phi = 2.0 * PI * j as f64 / segments as f64;
+            let n = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            positions.push(centre + n * radius);
+            normals.push(n);
+        }
+    }
+    let mut triangles = Vec::new();
+    let idx = |i: u32, j: u32| i * segments + (j % segments);
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1));
+            // Counter-clockwise seen from outside.
+            if i != 0 {
+                triangles.push([a, b, c]);
+            }
+            if i + 1 != rings {
+                triangles.push([b, d, c]);
+            }
+        }
+    }
+    Mesh {
+        positions,
+        normals,
+        triangles,
+    }
+}
+
+/// A square in the plane y = 0 of side `size`, facing +y, split into n × n cells.
+fn square(size: f64, n: u32) -> Mesh {
+    let mut positions = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let x = -size / 2.0 + size * j as f64 / n as f64;
+            let z = -size / 2.0 + size * i as f64 / n as f64;
+            positions.push(DVec3::new(x, 0.0, z));
+        }
+    }
+    let normals = vec![DVec3::Y; positions.len()];
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let a = i * (n + 1) + j;
+            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
+            // (b - a) × (c - a) = x × z = -y, so order a, c, b for +y.
+            triangles.push([a, c, b]);
+            triangles.push([b, c, d]);
+        }
+    }
+    Mesh {
+        positions,
+        normals,
+        triangles,
+    }
+}
+
+fn translucent(model: ModelKind, preset: &str, units_per_mm: f64) -> Material {
+    Material {
+        name: preset.into(),
+        kind: MaterialKind::Translucent(Translucent {
+            model,
+            medium: Medium::preset(preset).unwrap(),
+            units_per_mm,
+            texture: None,
+        }),
+    }
+}
+
+fn scene_with(mesh: Mesh, material: Material, lights: Vec<Light>, camera: Camera) -> Scene {
+    Scene {
+        name: "test".into(),
+        path: None,
+        camera,
+        lights,
+        materials: vec![material],
+        objects: vec![Object {
+            name: "object".into(),
+            material: 0,
+            mesh,
+            curvature: None,
+        }],
+        warnings: Vec::new(),
+    }
+}
+
+/// A large flat slab under a distant light, seen from above: away from the edges the exact
+/// sum equals the closed form F_t(η, cos θ_o)/(cπ) · E_t · R_d,total (a semi-infinite
+/// half-space's diffuse reflectance; pbrt Eq. 11.6-11.7).
+#[test]
+fn flat_slab_matches_closed_form() {
+    // marble: 1/σ'_t ≈ 0.4 mm (red) → scene unit = mm; a 40 mm square.
+    let units_per_mm = 1.0;
+    let material = translucent(ModelKind::BetterDipole, "marble", units_per_mm);
+    let e0 = [2.0, 1.0, 0.5];
+    let camera = Camera {
+        position: DVec3::new(0.0, 50.0, 0.0),
+        target: DVec3::ZERO,
+        up: DVec3::Z,
+        vfov_deg: 2.0,
+        width: 5,
+        height: 5,
+        pixel_samples: 1,
+    };
+    let scene = scene_with(
+        square(40.0, 8),
+        material,
+        vec![Light::Directional {
+            direction: DVec3::NEG_Y,
+            irradiance: e0,
+        }],
+        camera,
+    );
+    let exact = Exact {
+        irradiance: IrradianceSettings {
+            spacing_mfp: 0.25,
+            max_samples: 1_000_000,
+            light_samples: 1,
+        },
+    };
+    let out = render(&scene, &exact, &RenderSettings::default(), &NoProgress).unwrap();
+    let medium = Medium::preset("marble").unwrap();
+    let model = make_model(ModelKind::BetterDipole, &medium);
+    let eta = medium.eta();
+    let centre = 2 * 5 + 2;
+    // The camera looks straight down: cos θ_o ≈ 1 at the centre pixel.
+    let ft = ft_dielectric(1.0, eta);
+    for c in 0..3 {
+        let closed = ft / (fresnel_normalization(eta) * PI)
+            * ft
+            * e0[c]
+            * model.total_diffuse_reflectance(c);
+        let got = out.subsurface[centre][c];
+        let rel = (got - closed).abs() / closed;
+        eprintln!("slab channel {c}: exact {got:.6e}, closed form {closed:.6e}, rel {rel:.2e}");
+        assert!(
+            rel < 0.01,
+            "channel {c}: exact {got} vs closed form {closed} ({rel:.4})"
+        );
+    }
+}
+
+fn sphere_scene(model: ModelKind) -> Scene {
+    let camera = Camera {
+        position: DVec3::new(0.0, 0.0, 4.0),
+        target: DVec3::ZERO,
+        up: DVec3::Y,
+        vfov_deg: 30.0,
+        width: 24,
+        height: 24,
+        pixel_samples: 1,
+    };
+    // skin1, 1 scene unit = 10 mm: 1/σ'_t ≈ 0.13 (red) scene units on a unit sphere.
+    scene_with(
+        uv_sphere(DVec3::ZERO, 1.0, 48, 96),
+        translucent(model, "skin1", 0.1),
+        vec![Light::Point {
+            position: DVec3::new(3.0, 2.0, 3.0),
+            intensity: [10.0; 3],
+        }],
+        camera,
+    )
+}
+
+fn pixels(out: &RenderOutput) -> Vec<usize> {
+    out.translucent_pixels()
+}
+
+/// The path tracer converges to the integral the exact point sum approximates: with fine
+/// irradiance samples the two agree within the path tracer's stated error.
+#[test]
+fn pathtrace_agrees_with_exact_on_a_sphere() {
+    let scene = sphere_scene(ModelKind::BetterDipole);
+    let exact = render(
+        &scene,
+        &Exact {
+            irradiance: IrradianceSettings {
+                spacing_mfp: 0.25,
+                max_samples: 400_000,
+                light_samples: 1,
+            },
+        },
+        &RenderSettings::default(),
+        &NoProgress,
+    )
+    .unwrap();
+    let pt = render(
+        &scene,
+        &PathTrace {
+            spp: 256,
+            ..PathTrace::default()
+        },
+        &RenderSettings {
+            seed: 7,
+            ..RenderSettings::default()
+        },
+        &NoProgress,
+    )
+    .unwrap();
+    let px = pixels(&exact);
+    assert!(px.len() > 100, "the sphere covers {} pixels", px.len());
+    let se = pt
+        .std_error
+        .as_ref()
+        .expect("path tracer reports standard errors");
+    // Aggregate: the image means agree within 3 standard errors of the path tracer's mean
+    // plus 1 % for the point sum's discretisation.
+    for c in 0..3 {
+        let m_ex: f64 = px.iter().map(|&i| exact.subsurface[i][c]).sum::<f64>() / px.len() as f64;
+        let m_pt: f64 = px.iter().map(|&i| pt.subsurface[i][c]).sum::<f64>() / px.len() as f64;
+        let se_mean =
+            (px.iter().map(|&i| se[i][c] * se[i][c]).sum::<f64>()).sqrt() / px.len() as f64;
+        eprintln!(
+            "sphere channel {c}: exact mean {m_ex:.6e}, pathtrace {m_pt:.6e} ± {se_mean:.2e}"
+        );
+        assert!(
+            (m_ex - m_pt).abs() <= 3.0 * se_mean + 0.01 * m_ex,
+            "channel {c}: exact mean {m_ex}, pathtrace mean {m_pt} ± {se_mean}"
+        );
+    }
+    // Per pixel: nearly all pixels within 3 of their own standard errors (+1 % discretisation).
+    let ok = px
+        .iter()
+        .filter(|&&i| {
+            (0..3).all(|c| {
+                (exact.subsurface[i][c] - pt.subsurface[i][c]).abs()
+                    <= 3.0 * se[i][c] + 0.01 * exact.subsurface[i][c]
+            })
+        })
+        .count();
+    let frac = ok as f64 / px.len() as f64;
+    eprintln!("{ok} of {} pixels within 3 SE (+1 %)", px.len());
+    assert!(frac > 0.95, "only {frac:.3} of pixels agree within 3 SE");
+}
+
+/// Same seed, same bits, whatever the thread count; another seed changes the noise.
+#[test]
+fn renders_are_deterministic() {
+    let scene = sphere_scene(ModelKind::StandardDipole);
+    let methods: [&dyn Integrator; 2] = [
+        &Exact::default(),
+        &PathTrace {
+            spp: 2,
+            ..PathTrace::default()
+        },
+    ];
+    for method in methods {
+        let s = RenderSettings {
+            seed: 3,
+            ..RenderSettings::default()
+        };
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| render(&scene, method, &s, &NoProgress).unwrap())
+        };
+        let (a, b) = (run(1), run(2));
+        assert_eq!(a.subsurface, b.subsurface, "{}", method.name());
+        assert_eq!(a.total, b.total, "{}", method.name());
+        assert!(
+            a.subsurface
+                .iter()
+                .flatten()
+                .all(|v| v.is_finite() && *v >= 0.0)
+        );
+        if method.name() == "pathtrace" {
+            let other = render(
+                &scene,
+                method,
+                &RenderSettings {
+                    seed: 4,
+                    ..s.clone()
+                },
+                &NoProgress,
+            )
+            .unwrap();
+            assert_ne!(a.subsurface, other.subsurface);
+        }
+    }
+}
+
+/// Irradiance samples: areas sum to the object's area, spacing holds, and a sample facing a
+/// point light gets F_t · I cos θ / d².
+#[test]
+fn irradiance_samples_cover_the_object() {
+    let scene = sphere_scene(ModelKind::BetterDipole);
+    let geom = SceneGeometry::new(&scene);
+    let settings = IrradianceSettings {
+        spacing_mfp: 0.5,
+        max_samples: 50_000,
+        light_samples: 1,
+    };
+    let samples = irradiance::compute(&scene, &geom, &[0], &settings, 1);
+    assert_eq!(samples.len(), 1);
+    let s = &samples[0];
+    let mesh = &scene.objects[0].mesh;
+    let area: f64 = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum();
+    let sum: f64 = s.samples.iter().map(|x| x.area).sum();
+    assert!(
+        (sum - area).abs() < 1e-9 * area,
+        "areas sum to {sum}, mesh area {area}"
+    );
+    let medium = Medium::preset("skin1").unwrap();
+    let mfp = (0..3)
+        .map(|c| 1.0 / medium.sigma_t_reduced(c))
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        s.spacing >= 0.5 * mfp * 0.1 * (1.0 - 1e-12),
+        "spacing {}",
+        s.spacing
+    );
+    // Brute-force minimum distance over a subset.
+    let n = s.samples.len().min(1500);
+    for i in 0..n {
+        for j in 0..i {
+            let d = (s.samples[i].position - s.samples[j].position).length();
+            assert!(
+                d >= s.spacing * (1.0 - 1e-9),
+                "samples {i} and {j} are {d} apart"
+            );
+        }
+    }
+    // Closed-form irradiance for unshadowed samples facing the light.
+    let light = DVec3::new(3.0, 2.0, 3.0);
+    let mut checked = 0;
+    for x in &s.samples {
+        let d = light - x.position;
+        let wi = d.normalize();
+        let cos = x.normal.dot(wi);
+        if cos > 0.3 {
+            let expect = ft_dielectric(cos, medium.eta()) * 10.0 * cos / d.length_squared();
+            assert!(
+                (x.irradiance[0] - expect).abs() < 1e-9 * expect,
+                "{} vs {expect}",
+                x.irradiance[0]
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 100);
+}
