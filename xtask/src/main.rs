@@ -7,6 +7,7 @@
 //!   (see [`check_results`]).
 //! - `cargo xtask fuzz`: seeded fuzzing of the scene, OBJ and EXR readers and the `sss`
 //!   command line on stable Rust (see [`fuzz`]).
+//! - `cargo xtask docs`: regenerates `docs/cli.md`, the command-line reference (see [`docs`]).
 //! - `cargo xtask tables`: regenerates the `mc-table` model's Monte Carlo table
 //!   (`crates/bssrdf/data/mc_table.bin`, see [`tables`]).
 
@@ -14,6 +15,7 @@
 
 mod check_results;
 mod compare;
+mod docs;
 mod fuzz;
 mod tables;
 
@@ -40,6 +42,13 @@ enum Task {
     CheckResults {
         /// The compare output directory (holding results.csv).
         dir: PathBuf,
+    },
+    /// Regenerate docs/cli.md, the command-line reference, from the clap definitions and the
+    /// method registry.
+    Docs {
+        /// Compare with the committed file instead of writing it (fails if they differ).
+        #[arg(long)]
+        check: bool,
     },
     /// Regenerate the Monte Carlo table of the `mc-table` model (bit-identical on every run;
     /// about 700 CPU-seconds, 6 minutes on 2 idle cores).
@@ -166,6 +175,28 @@ fn workspace_root() -> PathBuf {
     manifest.parent().map(PathBuf::from).unwrap_or(manifest)
 }
 
+/// `cargo xtask --help` and each task's `--help`, as clap renders them (for `docs/cli.md`).
+fn xtask_help() -> Vec<(String, String)> {
+    use clap::CommandFactory;
+    let mut cmd = Cli::command();
+    cmd.build();
+    let mut out = vec![(
+        "cargo xtask".to_string(),
+        cmd.render_long_help().to_string(),
+    )];
+    for sub in cmd.get_subcommands() {
+        if sub.get_name() == "help" {
+            continue;
+        }
+        let mut sub = sub.clone();
+        out.push((
+            format!("cargo xtask {}", sub.get_name()),
+            sub.render_long_help().to_string(),
+        ));
+    }
+    out
+}
+
 fn fuzz_main(args: FuzzArgs) -> ExitCode {
     if args.seconds.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
         eprintln!("error: --seconds must be a non-negative number of seconds");
@@ -228,6 +259,16 @@ fn main() -> ExitCode {
     };
     let result = match cli.task {
         Task::Fuzz(args) => return fuzz_main(args),
+        Task::Docs { check } => {
+            let root = workspace_root();
+            return match docs::run(&root, &docs::reference(&xtask_help()), check) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            };
+        }
         Task::Tables(args) => {
             let config = tables::Config {
                 out: args
@@ -325,6 +366,22 @@ fn main() -> ExitCode {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The committed command-line reference is what `cargo xtask docs` generates now: a flag,
+    /// default or help text changed without regenerating it fails here.
+    #[test]
+    fn the_committed_cli_reference_is_current() {
+        let root = workspace_root();
+        let text = docs::reference(&xtask_help());
+        if let Err(e) = docs::run(&root, &text, true) {
+            panic!("{e}");
+        }
+        // The generator sees every task, hidden flags excepted.
+        for task in ["compare", "fuzz", "check-results", "docs", "tables"] {
+            assert!(text.contains(&format!("## `cargo xtask {task}`")), "{task}");
+        }
+        assert!(!text.contains("--worker"), "a hidden flag is documented");
+    }
 
     /// A bad `--shard` is one line naming the value and the rule; `--merge` and `--shard`
     /// do not go together.

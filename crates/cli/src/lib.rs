@@ -30,6 +30,7 @@ pub mod method_flags;
 pub mod presets_table;
 pub mod profile_table;
 pub mod progress;
+pub mod reference;
 
 use crate::commands::diff::DiffArgs;
 use crate::commands::filter::FilterArgs;
