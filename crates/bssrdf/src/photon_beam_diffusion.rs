@@ -154,7 +154,7 @@ pub fn beam_diffusion_ss(sigma_s: f64, sigma_a: f64, g: f64, eta: f64, r: f64) -
 /// Rows are [`N_RHO`] single-scattering albedos ρ_i = (1 − e^{−8i/99})/(1 − e^{−8}), columns
 /// [`N_RADIUS`] optical radii (0, 2.5·10⁻³, then ×1.2 up to ≈ 204 mean free paths); entry
 /// (i, j) is 2π r_j (SS + MS)(r_j) for σ_t = 1, σ_s = ρ_i. The effective albedo of each row
-/// and its running integral come from [`integrate_catmull_rom`] over the radii, so they
+/// and its running integral come from [`integrate_catmull_rom`](crate::catmull_rom::integrate_catmull_rom) over the radii, so they
 /// describe exactly the spline that [`crate::catmull_rom::sample_catmull_rom_2d`] samples.
 /// The table itself is the toolkit's one [`ProfileTable`], which this dereferences to.
 ///
@@ -248,7 +248,7 @@ impl PbdTable {
 ///   limited spline, so the pdf integrates to 1 exactly.
 /// - All three use the table's rows blended once per channel at the channel's albedo when the
 ///   model is built ([`SplineRow`]: 63 intervals, ≈ 5 KB and a few µs per channel): the same
-///   spline as the per-call tensor interpolation of [`PbdTable::interpolate_profile`] up to
+///   spline as the per-call tensor interpolation of [`ProfileTable::interpolate_profile`] up to
 ///   rounding, evaluated with a constant-time knot lookup.
 /// - When the interpolated ρ_eff is not positive (albedo 0) both fall back to the
 ///   exponential distribution σ_t e^{−σ_t r}.

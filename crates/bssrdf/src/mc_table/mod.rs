@@ -1,7 +1,7 @@
 //! `mc-table`: the radial profile of the crate's own photon random walk ([`crate::monte_carlo`])
 //! tabulated once over albedo, optical radius, relative index η and anisotropy g, and
 //! evaluated and sampled like the photon beam diffusion table (pbrt 3rd ed. §11.4.2, §15.4.2:
-//! Catmull-Rom in albedo and radius, [`SplineRow`] rows pre-blended per channel), so a
+//! Catmull-Rom in albedo and radius, [`SplineRow`](crate::spline_row::SplineRow) rows pre-blended per channel), so a
 //! renderer gets the random walk's profile at the cost of a table lookup.
 //!
 //! # The table
@@ -56,7 +56,7 @@
 //! origin and the poorly resolved far tail are pooled into resolved groups ([`inner_masses`],
 //! [`tail_masses`]); after it, R_d at the knots is made non-increasing by an isotonic fit
 //! ([`row_nodes`]), and the model makes the first interval [0, 0.1 x₁] linear in T
-//! ([`SplineRow::with_linear_first_segment`]) and keeps the row it blends for a medium
+//! ([`SplineRow::with_linear_first_segment`](crate::spline_row::SplineRow::with_linear_first_segment)) and keeps the row it blends for a medium
 //! non-increasing in R_d (`monotone_row`). The spline then reproduces every tallied bin
 //! integral where the tallies are resolved and ordered, and its total stays within 3 standard
 //! errors of the tallied total reflectance for every albedo ≥ 0.5 (tested).

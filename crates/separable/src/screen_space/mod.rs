@@ -23,7 +23,7 @@
 //!   the centre pixel's value instead). Either way a constant irradiance is reproduced and no
 //!   light crosses to another object.
 //!
-//! Evaluation: rows are cut into chunks of 64 pixels (`rows.rs`). A chunk whose pixels all
+//! Evaluation: rows are cut into chunks of 64 pixels (`rows.rs`, the chunk driver; `chunk.rs`, what the chunk loops share). A chunk whose pixels all
 //! show one blurred object, and whose taps can only reach texels of that object within the
 //! depth threshold, runs every tap over the chunk with contiguous reads and no per-texel
 //! tests; that test is hoisted into a per-frame summary of object ids, depth ranges and
@@ -39,20 +39,27 @@
 //! on every built-in scene. Which pixels take which form depends only on the inputs, so the
 //! result is identical for any thread count.
 //!
-//! On x86-64 with AVX2 and FMA (checked at run time) the chunks run in `groups.rs`: groups
+//! Files by concern: `summary.rs` (the per-frame cells, bands and blocks the chunks are
+//! tested against), `rotation.rs` (the per-pixel rotation table), `chunk.rs` (what the chunk
+//! loops share: taps, context, scratch, output), `rows.rs` (the driver: which chunks take the
+//! fast path, and which loops sum them), `portable.rs` (the portable loops), `avx2.rs` (every
+//! AVX2 + FMA form: the group loops, the summary's cells and the rotation table), `pixel.rs`
+//! (the per-pixel reference). Only this file chooses between the instruction sets' forms of
+//! the summary and table; the driver chooses the chunk loops.
+//!
+//! On x86-64 with AVX2 and FMA (checked at run time) the chunks run in `avx2.rs`: groups
 //! of 8 pixels whose 24 sums are three 8-lane vectors, taps as the outer loop so that a
 //! tap's integer offset and runs are found once per chunk, per-pixel fractions spread over
 //! the channels by permutes, rotated taps as two 8-float loads per pixel. It is written with
 //! intrinsics; its `unsafe` parts are the call into it after the CPU check, the gathers of
 //! the rotation table and the rotated taps' loads from cells checked inside the image once
-//! per group. The portable loops (`rows.rs`, kept for other CPUs and tested against the same
+//! per group. The portable loops (`portable.rs`, kept for other CPUs and tested against the same
 //! reference as `Evaluation::RowsBaseline`) keep their sums in memory and, compiled for
 //! AVX2, took 1.2–1.4× the time without jitter on the benchmark frames (`docs/benchmarks.md`). The
-//! baseline build multiplies and adds separately, so the two builds differ by rounding. Where
-//! the CPU also has AVX-512F, `groups16.rs` runs the same loops on groups of 16 pixels (a
-//! tap's positions and cells for 16 pixels per instruction, two pixels' rotated reads per
-//! register) with the same operations per pixel, so it gives the AVX2 loops' bits exactly
-//! (`Evaluation::RowsAvx2` holds a run to the AVX2 loops, for that test). Cost and its
+//! baseline build multiplies and adds separately, so the two builds differ by rounding. There
+//! is no AVX-512 form: a 16-pixel form of the same loops gave the AVX2 loops' bits and gained
+//! 1.09× in the benchmark's full run on an AVX-512 Xeon (1.1–1.35× in other runs), too little
+//! for six hundred lines of `unsafe` code that no CI machine without AVX-512 runs. Cost and its
 //! breakdown: `crates/bench/benches/separable.rs` and `docs/benchmarks.md`.
 //!
 //! Output: per pixel, the diffuse exitance E ∗ R_d (with [`crate::Energy::TotalReflectance`]
@@ -61,19 +68,25 @@
 //! depends only on the inputs, so the result is identical for any thread count.
 
 #[cfg(target_arch = "x86_64")]
-mod groups;
-#[cfg(target_arch = "x86_64")]
-mod groups16;
+mod avx2;
+mod chunk;
 mod pixel;
+mod portable;
+mod rotation;
 mod rows;
+mod summary;
+#[cfg(test)]
+mod tests;
 
 use crate::error::{SeparableError, ensure};
 use crate::kernel::SeparableKernel;
+use chunk::{ChunkTaps, Ctx, Lanes, RowOut};
 use pixel::{Pass, PassTaps};
 use rayon::prelude::*;
-use rows::{Cell, ChunkTaps, Ctx, Lanes, PixelTable, RowOut, Summary};
+use rotation::PixelTable;
 use sss_util::splitmix64;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use summary::{Cell, CellSummary};
 
 /// The `mask` value of pixels that show no translucent object.
 pub const NO_OBJECT: u32 = u32::MAX;
@@ -319,9 +332,6 @@ pub enum Evaluation {
     /// are available (multiplies and adds not fused: the two agree within rounding), the
     /// per-frame summary and rotation table included (the same bits either way).
     RowsBaseline,
-    /// [`Evaluation::Rows`] with the 8-pixel AVX2 groups even where AVX-512 is available
-    /// (the same sums: the 16-pixel groups do the same operations).
-    RowsAvx2,
     /// Every tap of every pixel fetched and tested on its own: the plain form the chunked one
     /// is tested against (and measured against in `crates/bench/benches/separable.rs`).
     PerPixel,
@@ -388,16 +398,15 @@ fn run(
         evaluation != Evaluation::PerPixel && 3 * (n + input.width) + 8 <= i32::MAX as usize;
     let isa = match evaluation {
         Evaluation::RowsBaseline => Isa::Baseline,
-        Evaluation::RowsAvx2 => Isa::Avx2,
         _ => Isa::Best,
     };
     let tables = chunked.then(|| {
         (
-            Summary::new(
+            CellSummary::new(
                 input,
                 &rules,
                 std::mem::take(&mut scratch.summary),
-                isa != Isa::Baseline,
+                &summary_rows(isa),
             ),
             PixelTable::new(
                 input,
@@ -405,7 +414,7 @@ fn run(
                 jitter,
                 std::mem::take(&mut scratch.rotation),
                 &mut scratch.rotation_key,
-                isa != Isa::Baseline,
+                &rotation_rows(isa),
             ),
         )
     });
@@ -447,16 +456,58 @@ fn run(
 enum Isa {
     /// The x86-64 baseline ([`Evaluation::RowsBaseline`]).
     Baseline,
-    /// AVX2 and FMA at most ([`Evaluation::RowsAvx2`]).
-    Avx2,
-    /// AVX-512 where the CPU has it.
+    /// AVX2 and FMA where the CPU has them.
     Best,
+}
+
+/// Whether the AVX2 code may run: the CPU has it and `isa` allows it.
+fn use_avx2(isa: Isa) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        isa != Isa::Baseline && std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = isa;
+        false
+    }
+}
+
+/// The summary's row builder for `isa`: [`avx2::summary_row_avx2`] where it may run, else the
+/// portable [`summary::summary_row`] (the same cells either way).
+fn summary_rows(isa: Isa) -> impl Fn(&ScreenInput, &Rules, usize, &mut [Cell]) + Sync {
+    let avx2 = use_avx2(isa);
+    move |input, rules, y, row| {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: `use_avx2` checked that the CPU supports AVX2, the only requirement of
+            // calling a function compiled with it.
+            return unsafe { avx2::summary_row_avx2(input, rules, y, row) };
+        }
+        let _ = avx2;
+        summary::summary_row(input, rules, y, row)
+    }
+}
+
+/// The rotation table's row builder for `isa`, as [`summary_rows`] (the same bytes either
+/// way).
+fn rotation_rows(isa: Isa) -> impl Fn(usize, u64, &mut [u8]) + Sync {
+    let avx2 = use_avx2(isa);
+    move |y, seed, row| {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: as in `summary_rows`.
+            return unsafe { avx2::rotation_row_avx2(y, seed, row) };
+        }
+        let _ = avx2;
+        rotation::rotation_row(y, seed, row)
+    }
 }
 
 /// One pass over every row: `pass.src` into `dst`, added to it when `accumulate`.
 fn run_pass(
     pass: &Pass,
-    tables: Option<&(Summary, PixelTable)>,
+    tables: Option<&(CellSummary, PixelTable)>,
     isa: Isa,
     dst: &mut [[f32; 3]],
     accumulate: bool,
@@ -472,7 +523,7 @@ fn run_pass(
 
 fn rows_of<const VERTICAL: bool, const JITTER: bool>(
     pass: &Pass,
-    tables: Option<&(Summary, PixelTable)>,
+    tables: Option<&(CellSummary, PixelTable)>,
     isa: Isa,
     dst: &mut [[f32; 3]],
     accumulate: bool,
@@ -484,7 +535,7 @@ fn rows_of<const VERTICAL: bool, const JITTER: bool>(
         Some((summary, table)) => {
             let taps = ChunkTaps::new(pass);
             #[cfg(target_arch = "x86_64")]
-            let groups = groups::GroupTaps::new(pass, &taps);
+            let groups = avx2::GroupTaps::new(pass, &taps);
             let ctx = Ctx {
                 summary,
                 table,
@@ -492,8 +543,6 @@ fn rows_of<const VERTICAL: bool, const JITTER: bool>(
                 #[cfg(target_arch = "x86_64")]
                 groups: &groups,
                 baseline: isa == Isa::Baseline,
-                #[cfg(target_arch = "x86_64")]
-                avx512: isa == Isa::Best && std::arch::is_x86_feature_detected!("avx512f"),
             };
             rows.for_each_init(Lanes::new, |lanes, (y, row)| {
                 let out = RowOut {

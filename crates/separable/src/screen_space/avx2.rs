@@ -26,9 +26,15 @@
 //!
 //! The rounding differs from the per-pixel form's (fused multiply-adds, rotated taps summed
 //! last), within the tolerance stated in [`super`].
+//!
+//! The AVX2 forms of the per-frame summary's cells ([`summary_row_avx2`]) and of the rotation
+//! table ([`rotation_row_avx2`]) live here too, beside the group loops: every AVX2 + FMA path
+//! of the pass is in this file, each tested against its portable form bit for bit.
 
+use super::chunk::{CHUNK, ChunkTaps, Ctx, RowOut, store};
 use super::pixel::Pass;
-use super::rows::{ChunkTaps, Ctx, RowOut, store};
+use super::summary::{CELL, Cell, order_bits, summary_cell};
+use super::{NO_OBJECT, Rules, ScreenInput, rotation_index};
 use std::arch::x86_64::*;
 
 /// Pixels per group (one 8-lane register per channel triple of floats).
@@ -39,8 +45,8 @@ const HELD: usize = 4;
 /// The pass's taps as the group loop uses them, by kind (the centre tap, the axis-aligned
 /// ones, the rotated ones), each with its weights laid out for the group's registers.
 pub(super) struct GroupTaps {
-    /// Offset-0 taps: their weights over 48 floats (RGB repeated: an 8-pixel group reads
-    /// the first 24, a 16-pixel one of [`super::groups16`] all).
+    /// Offset-0 taps: their weights over 48 floats (RGB repeated; an 8-pixel group reads the
+    /// first 24).
     pub(super) centre: Vec<[f32; 6 * G]>,
     /// Axis-aligned taps: offset (mm) and weights over the 48 floats.
     pub(super) axis: Vec<(f32, [f32; 6 * G])>,
@@ -156,7 +162,7 @@ pub(super) struct Sources<'a> {
 }
 
 /// Groups in a chunk, at most.
-pub(super) const GROUPS: usize = super::rows::CHUNK / G;
+pub(super) const GROUPS: usize = CHUNK / G;
 
 /// Sums the `n` pixels of row `y` from column `x0` (a chunk that passed the silhouette test)
 /// into `out`: whole groups of 8 here, the rest (and any group the registers cannot take)
@@ -641,4 +647,188 @@ fn perm(v: __m256, i: [i32; 8]) -> __m256 {
         v,
         _mm256_setr_epi32(i[0], i[1], i[2], i[3], i[4], i[5], i[6], i[7]),
     )
+}
+
+/// [`summary_row`] in AVX2: each whole cell of [`CELL`] pixels as two 8-lane halves
+/// ([`summary_cell_avx2`]), a partial last cell as the scalar form.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+pub(super) fn summary_row_avx2(input: &ScreenInput, rules: &Rules, y: usize, row: &mut [Cell]) {
+    let w = input.width;
+    for (c, cell) in row.iter_mut().enumerate() {
+        let a = y * w + c * CELL;
+        let b = (a + CELL).min(y * w + w);
+        let (mask, depth, mm) = (
+            &input.mask[a..b],
+            &input.depth[a..b],
+            &input.mm_per_pixel[a..b],
+        );
+        *cell = match (mask.try_into(), depth.try_into(), mm.try_into()) {
+            (Ok(mask), Ok(depth), Ok(mm)) => summary_cell_avx2(mask, depth, mm, rules),
+            _ => summary_cell(mask, depth, mm, rules),
+        };
+    }
+}
+
+/// [`summary_cell`] of a whole cell in AVX2, the same bits: the folds are integer
+/// (order-preserving keys of the depths, bits of the positive inverse footprints) and the
+/// footprint rule is [`Rules::inverse_scale_lane`]'s f32 operations, lane by lane.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+pub(super) fn summary_cell_avx2(
+    mask: &[u32; CELL],
+    depth: &[f32; CELL],
+    mm: &[f32; CELL],
+    rules: &Rules,
+) -> Cell {
+    use std::arch::x86_64::*;
+    const _: () = assert!(CELL == 16, "two 8-lane halves");
+    let id = mask[0];
+    let idv = _mm256_set1_epi32(id as i32);
+    let exp = _mm256_set1_epi32(0x7F80_0000);
+    let sign = _mm256_set1_epi32(i32::MIN);
+    let (one, zero) = (_mm256_set1_ps(1.0), _mm256_setzero_ps());
+    let (twice_support, min_fp) = (
+        _mm256_set1_ps(2.0 * rules.support_mm),
+        _mm256_set1_ps(rules.min_footprint_px),
+    );
+    let (mut odd, mut inv_bits) = (_mm256_setzero_si256(), _mm256_setzero_si256());
+    let (mut lo, mut hi) = (_mm256_set1_epi32(-1), _mm256_setzero_si256());
+    let mut ok_all = -1i32;
+    for half in 0..2 {
+        // SAFETY: each array holds 16 values; the loads read 8 from 0 or 8.
+        let (m, bits, f) = unsafe {
+            (
+                _mm256_loadu_si256(mask.as_ptr().add(8 * half).cast()),
+                _mm256_loadu_si256(depth.as_ptr().add(8 * half).cast()),
+                _mm256_loadu_ps(mm.as_ptr().add(8 * half)),
+            )
+        };
+        // `odd`: another id, or a non-finite depth.
+        let non_finite = _mm256_cmpeq_epi32(_mm256_and_si256(bits, exp), exp);
+        odd = _mm256_or_si256(odd, _mm256_or_si256(_mm256_xor_si256(m, idv), non_finite));
+        // order_key: bits ^ (neg | 0x8000_0000), neg = all ones for a set sign bit.
+        let key = _mm256_xor_si256(bits, _mm256_or_si256(_mm256_srai_epi32::<31>(bits), sign));
+        lo = _mm256_min_epu32(lo, key);
+        hi = _mm256_max_epu32(hi, key);
+        // inverse_scale_lane: (mm > 0) & mm finite & 2·support·inv ≥ min & inv finite.
+        let inv = _mm256_div_ps(one, f);
+        let ok = _mm256_and_ps(
+            _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(f, zero), finite_lanes(f)),
+            _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_GE_OQ>(_mm256_mul_ps(twice_support, inv), min_fp),
+                finite_lanes(inv),
+            ),
+        );
+        ok_all &= _mm256_movemask_ps(ok);
+        inv_bits = _mm256_max_epu32(inv_bits, _mm256_castps_si256(_mm256_and_ps(ok, inv)));
+    }
+    let odd = _mm256_testz_si256(odd, odd) == 0;
+    Cell {
+        id,
+        uniform: id != NO_OBJECT && !odd,
+        dmin: f32::from_bits(order_bits(fold_u32::<false>(lo))),
+        dmax: f32::from_bits(order_bits(fold_u32::<true>(hi))),
+        blurred: ok_all & 0xFF == 0xFF,
+        inv_max: f32::from_bits(fold_u32::<true>(inv_bits)),
+    }
+}
+
+/// The largest (`MAX`) or smallest of the 8 unsigned lanes of `v`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(super) fn fold_u32<const MAX: bool>(v: std::arch::x86_64::__m256i) -> u32 {
+    use std::arch::x86_64::*;
+    let mut v = v;
+    for step in 0..3 {
+        let other = match step {
+            0 => _mm256_permute2x128_si256::<1>(v, v),
+            1 => _mm256_shuffle_epi32::<0b01_00_11_10>(v),
+            _ => _mm256_shuffle_epi32::<0b10_11_00_01>(v),
+        };
+        v = if MAX {
+            _mm256_max_epu32(v, other)
+        } else {
+            _mm256_min_epu32(v, other)
+        };
+    }
+    _mm256_cvtsi256_si32(v) as u32
+}
+
+/// All ones in the lanes of `v` that are finite, zeros elsewhere.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(super) fn finite_lanes(v: std::arch::x86_64::__m256) -> std::arch::x86_64::__m256 {
+    use std::arch::x86_64::*;
+    let exp = _mm256_set1_epi32(0x7F80_0000);
+    let e = _mm256_and_si256(_mm256_castps_si256(v), exp);
+    _mm256_castsi256_ps(_mm256_xor_si256(
+        _mm256_cmpeq_epi32(e, exp),
+        _mm256_set1_epi32(-1),
+    ))
+}
+
+/// [`rotation_row`] four pixels at a time in AVX2's 64-bit lanes: the SplitMix64 finaliser
+/// with each 64-bit product built from three 32-bit ones (AVX2 has no 64-bit multiply), so
+/// every index is the scalar one, bit for bit (integer arithmetic).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+pub(super) fn rotation_row_avx2(y: usize, seed: u64, row: &mut [u8]) {
+    use std::arch::x86_64::*;
+    /// a · m (mod 2⁶⁴) per lane, m = (m_hi, m_lo) as 32-bit halves in each lane.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn mul64(a: __m256i, m_lo: __m256i, m_hi: __m256i) -> __m256i {
+        let lo = _mm256_mul_epu32(a, m_lo);
+        let cross = _mm256_add_epi64(
+            _mm256_mul_epu32(_mm256_srli_epi64::<32>(a), m_lo),
+            _mm256_mul_epu32(a, m_hi),
+        );
+        _mm256_add_epi64(lo, _mm256_slli_epi64::<32>(cross))
+    }
+    /// The multipliers of `splitmix64_mix` as (low, high) 32-bit halves in 64-bit lanes.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn halves(m: u64) -> (__m256i, __m256i) {
+        (
+            _mm256_set1_epi64x((m & 0xffff_ffff) as i64),
+            _mm256_set1_epi64x((m >> 32) as i64),
+        )
+    }
+    const _: () = assert!(super::ROTATION_STEPS == 256, "the index is the top byte");
+    let (m1_lo, m1_hi) = halves(0xbf58_476d_1ce4_e5b9);
+    let (m2_lo, m2_hi) = halves(0x94d0_49bb_1331_11eb);
+    // splitmix64(seed + ((y << 32) ^ x)) = mix(seed + (y << 32) + x + γ): x < 2³² (the image
+    // width is at most i32::MAX), so the xor is an add.
+    let start = seed
+        .wrapping_add((y as u64) << 32)
+        .wrapping_add(sss_util::GOLDEN_GAMMA);
+    let mut z0 = _mm256_add_epi64(
+        _mm256_set1_epi64x(start as i64),
+        _mm256_setr_epi64x(0, 1, 2, 3),
+    );
+    let four = _mm256_set1_epi64x(4);
+    let done = row.len() / 4 * 4;
+    let mut quads = row.chunks_exact_mut(4);
+    for q in &mut quads {
+        let mut z = _mm256_xor_si256(z0, _mm256_srli_epi64::<30>(z0));
+        z = mul64(z, m1_lo, m1_hi);
+        z = _mm256_xor_si256(z, _mm256_srli_epi64::<27>(z));
+        z = mul64(z, m2_lo, m2_hi);
+        z = _mm256_xor_si256(z, _mm256_srli_epi64::<31>(z));
+        // The top byte of each lane (`>> 56`; ROTATION_STEPS = 256 makes the `%` a no-op).
+        let top = _mm256_srli_epi64::<56>(z);
+        let mut v = [0u64; 4];
+        // SAFETY: `v` holds four 64-bit lanes.
+        unsafe { _mm256_storeu_si256(v.as_mut_ptr().cast(), top) };
+        for (r, v) in q.iter_mut().zip(v) {
+            *r = v as u8;
+        }
+        z0 = _mm256_add_epi64(z0, four);
+    }
+    for (x, r) in quads.into_remainder().iter_mut().enumerate() {
+        *r = rotation_index(done + x, y, seed) as u8;
+    }
 }
