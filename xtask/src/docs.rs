@@ -20,6 +20,9 @@ pub fn reference(xtask_help: &[(String, String)]) -> String {
     );
     out.push_str(&sss_cli::reference::markdown());
     for (title, help) in xtask_help {
+        if title == "cargo xtask compare" {
+            out.push_str(&experiments());
+        }
         out.push_str(&format!("## `{title}`\n\n```text\n"));
         for line in help.trim_end().lines() {
             out.push_str(line.trim_end());
@@ -28,6 +31,27 @@ pub fn reference(xtask_help: &[(String, String)]) -> String {
         out.push_str("```\n\n");
     }
     out.truncate(out.trim_end().len());
+    out.push('\n');
+    out
+}
+
+/// The registry of `cargo xtask compare`'s experiments (`sss_compare::EXPERIMENTS`) as a
+/// table: which run by default and which by their own flag.
+fn experiments() -> String {
+    let mut out = String::from(
+        "## Experiments of `cargo xtask compare`\n\n\
+         From the registry `sss_compare::EXPERIMENTS`, in report order:\n\n\
+         | experiment | runs | what |\n|---|---|---|\n",
+    );
+    for e in sss_compare::EXPERIMENTS {
+        let runs = match e.selection {
+            sss_compare::Selection::Default => "by default".to_string(),
+            sss_compare::Selection::Flag(f) => {
+                format!("with `--{f}` (instead of the default ones)")
+            }
+        };
+        out.push_str(&format!("| `{}` | {runs} | {} |\n", e.name, e.about));
+    }
     out.push('\n');
     out
 }

@@ -14,12 +14,12 @@
 #![forbid(unsafe_code)]
 
 mod check_results;
-mod compare;
 mod docs;
 mod fuzz;
 mod tables;
 
 use clap::{Parser, Subcommand};
+use sss_compare as compare;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -381,6 +381,9 @@ mod tests {
             assert!(text.contains(&format!("## `cargo xtask {task}`")), "{task}");
         }
         assert!(!text.contains("--worker"), "a hidden flag is documented");
+        for e in sss_compare::EXPERIMENTS {
+            assert!(text.contains(&format!("| `{}` |", e.name)), "{}", e.name);
+        }
     }
 
     /// A bad `--shard` is one line naming the value and the rule; `--merge` and `--shard`

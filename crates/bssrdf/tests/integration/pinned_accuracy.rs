@@ -7,7 +7,7 @@
 //! scale is checked by a scaling law and by the mean exit radius of photon beam diffusion.
 //!
 //! # How the Monte Carlo comparison is measured
-//! As `cargo xtask compare` does it (xtask/src/compare/{profiles,metrics,reference}.rs): one
+//! As `cargo xtask compare` does it (crates/compare/src/{profiles,metrics,reference}.rs): one
 //! single-channel simulation per (preset, channel), [`BINS`] linear bins over [0, r_max] with
 //! r_max the standard dipole's radius holding 99 % of its reflectance; the model's *area
 //! averages* over the same annuli; the relative L2 error of the energy per bin,
@@ -16,7 +16,7 @@
 //! collision); photon beam diffusion, normalized diffusion, `mc-table` and the directional
 //! dipole against the full tally (the directional dipole puts a source of strength 1, not α′, at the ray's
 //! first scattering event — Frisvad et al. 2014, Eq. 20 — so it stands for all scattered light;
-//! `McPart::All` in xtask/src/compare/profiles.rs).
+//! `McPart::All` in crates/compare/src/profiles.rs).
 //!
 //! # Margins
 //! The simulation is seeded ([`SEED`]) and bit-identical for any thread count, so every value

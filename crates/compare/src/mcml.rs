@@ -68,13 +68,7 @@ pub fn reference_dir() -> PathBuf {
 fn dir_from(env: Option<std::ffi::OsString>) -> PathBuf {
     match env {
         Some(d) if !d.is_empty() => PathBuf::from(d),
-        _ => {
-            let xtask = Path::new(env!("CARGO_MANIFEST_DIR"));
-            xtask
-                .parent()
-                .unwrap_or(xtask)
-                .join("../shared/reference/mcml")
-        }
+        _ => crate::workspace_root().join("../shared/reference/mcml"),
     }
 }
 
@@ -1000,7 +994,7 @@ mod tests {
                 .unwrap()
                 .parent()
                 .unwrap(),
-            Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap()
+            crate::workspace_root().as_path()
         );
     }
 }

@@ -206,7 +206,7 @@ fn load(path: &Path, image_pixels: usize) -> Result<Option<SubsetReference>, Str
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::compare::checked::tests as t;
+    use crate::checked::tests as t;
     use sss_render::render;
 
     /// A subset reference of the built-in sphere at 24×18: the stored values equal the full

@@ -40,43 +40,7 @@ use std::fmt::Write as _;
 /// The paper-scale bunny: the full-resolution scan (35 947 vertices, in metres) scaled ×64 to
 /// the built-in bunny's size (about 10 units wide) on its ground, in skin1 with photon beam
 /// diffusion, under the built-in bunny's point light and camera.
-pub const BUNNY: &str = r#"# Paper-scale bunny of `cargo xtask compare --trees`.
-[camera]
-position = [0.0, 7.0, 24.0]
-target = [0.0, 4.6, 0.0]
-fov = 30.0
-resolution = [1024, 1024]
-
-[[lights]]
-type = "point"
-position = [10.0, 20.0, 15.0]
-intensity = 2000.0
-
-[materials.bunny]
-type = "translucent"
-model = "pbd"
-preset = "skin1"
-units_per_mm = 0.2
-
-[materials.ground]
-type = "diffuse"
-albedo = 0.5
-
-[[objects]]
-name = "ground"
-material = "ground"
-shape = "plane"
-size = [40.0, 40.0]
-
-[[objects]]
-name = "bunny"
-material = "bunny"
-shape = "mesh"
-file = "stanford-bunny.obj"
-# x in [-0.0947, 0.0610], y in [0.0330, 0.1873], z in [-0.0619, 0.0588] metres: centre it in
-# x and z and lift its lowest point onto the ground.
-transform = { scale = [64.0, 64.0, 64.0], translate = [1.078, -2.108, 0.099] }
-"#;
+pub const BUNNY: &str = include_str!("../../../scenes/experiments/trees-bunny.toml");
 
 /// The trees experiment.
 pub struct TreeExperiment;

@@ -380,7 +380,7 @@ mod tests {
 
     #[test]
     fn cached_file_is_checked_before_it_is_trusted() {
-        use crate::compare::checked::{sum_path, tests as t};
+        use crate::checked::{sum_path, tests as t};
         let cfg = McConfig {
             photons: 10,
             seed: 3,

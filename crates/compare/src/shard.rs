@@ -187,8 +187,8 @@ fn work(plan: &scenes::ScenePlan, quick: bool) -> Vec<(Work, f64)> {
 /// The version of the code: the package version and the git commit of the workspace (with
 /// `+dirty` when tracked files differ from it), or `unknown` without git.
 fn version() -> String {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let root = root.parent().unwrap_or(&root);
+    let root = crate::workspace_root();
+    let root = root.as_path();
     let git = |args: &[&str]| {
         std::process::Command::new("git")
             .arg("-C")

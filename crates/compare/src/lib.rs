@@ -1,18 +1,48 @@
-//! `cargo xtask compare`: the project's main measurement.
+//! # sss-compare: the comparison experiments behind `cargo xtask compare`
+//!
+//! The project's main measurement, as a library: every BSSRDF model against the Monte Carlo
+//! reference, every rendering method against an independent reference, error against run
+//! time, written as `report.md`, `results.csv`, `profiles.csv`, images and plots. `cargo
+//! xtask compare` parses its flags into a [`Config`] and calls [`run`]; use the library to run
+//! the experiments from your own driver or a cluster job.
 //!
 //! 1. For every selected preset and channel, the Monte Carlo reference is loaded from the
-//!    cache or simulated ([`mod@reference`]).
-//! 2. Each registered [`Experiment`] uses the references and contributes a report
-//!    [`Section`] plus its own files (today: [`profiles::ProfileComparison`], every model's
-//!    radial profile against Monte Carlo; the rendering methods follow).
+//!    cache or simulated (module `reference`).
+//! 2. Each selected [`Experiment`] of the registry [`EXPERIMENTS`] uses the references and
+//!    contributes a report [`Section`] plus its own files: `profiles` (every model's radial
+//!    profile against Monte Carlo), `scenes` (every rendering method over its sweep) and
+//!    `kernels` (the separable kernels) by default; `trees` and `manylight`, the paper-scale
+//!    experiments, by their flags.
 //! 3. `report.md` is assembled from the sections.
 //!
 //! Everything random is seeded ([`Config::seed`]), so error figures are reproducible; only
 //! the timings vary from run to run.
 //!
-//! The default experiments can be split over many machines ([`shard`]): `--prepare` fills the
+//! The default experiments can be split over many machines (module `shard`): `--prepare` fills the
 //! reference cache, `--shard I/N` runs a share of the work, `--merge` joins the shares into
 //! the same `results.csv`, plots and report.
+//!
+//! ```no_run
+//! use sss_compare::{Config, run};
+//!
+//! // Profiles of one preset and the sphere scene's renders, into target/compare-sphere.
+//! let mut config = Config::new(
+//!     vec!["skin1".into()],
+//!     vec!["sphere".into()],
+//!     "target/compare-sphere".into(),
+//! );
+//! config.quick = true;
+//! run(&config)?;
+//! # Ok::<(), sss_compare::Error>(())
+//! ```
+//!
+//! ## Papers
+//! What it measures is the other crates' (their docs cite the papers); the experiments test
+//! the claims of Jensen et al. 2001 and d'Eon 2012 (profiles against MCML-style Monte Carlo,
+//! Wang et al. 1995), Jimenez et al. 2015 (kernels), Milaenen et al. 2019 (`trees`) and Nabata
+//! & Iwasaki 2021 (`manylight`, with Walter et al. 2006 and Sakai et al. 2019 as baselines).
+
+#![forbid(unsafe_code)]
 
 mod checked;
 mod host;
@@ -71,15 +101,15 @@ pub struct Config {
     pub mesh_dirs: Vec<PathBuf>,
     /// The fast variant (smaller images, shorter sweeps).
     pub quick: bool,
-    /// Run only the paper-scale tree experiments ([`trees`]).
+    /// Run only the paper-scale tree experiments (module `trees`).
     pub trees: bool,
-    /// Run only the paper-scale many-light experiments ([`manylight`]).
+    /// Run only the paper-scale many-light experiments (module `manylight`).
     pub manylight: bool,
-    /// Run only this share of the default experiments ([`shard`]).
+    /// Run only this share of the default experiments (module `shard`).
     pub shard: Option<Shard>,
-    /// Join these shard directories into `out` instead of running anything ([`shard`]).
+    /// Join these shard directories into `out` instead of running anything (module `shard`).
     pub merge: Vec<PathBuf>,
-    /// Only compute the references into the cache ([`shard`]'s first job).
+    /// Only compute the references into the cache (the first job of a sharded run).
     pub prepare: bool,
     /// The cache directory [default: `out/cache`].
     pub cache: Option<PathBuf>,
@@ -117,6 +147,17 @@ impl Config {
     pub fn cache_dir(&self) -> PathBuf {
         self.cache.clone().unwrap_or_else(|| self.out.join("cache"))
     }
+}
+
+/// The workspace root (this crate lives in `crates/compare`): where the shared data next to
+/// the repository (`../shared`) and git are looked up.
+pub fn workspace_root() -> PathBuf {
+    let manifest = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    manifest
+        .ancestors()
+        .nth(2)
+        .unwrap_or(manifest)
+        .to_path_buf()
 }
 
 /// A failure, with a message for a person.
@@ -158,23 +199,79 @@ pub trait Experiment {
     fn run(&self, ctx: &Context<'_>) -> Result<Section, Error>;
 }
 
+/// When an experiment runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Selection {
+    /// In every default run (and in its shards and merges).
+    Default,
+    /// Only when asked for by its own flag (`--trees`, `--manylight`): a paper-scale
+    /// experiment, which needs no Monte Carlo reference and runs instead of the default ones.
+    Flag(&'static str),
+}
+
+/// A registry entry: what the command line and the run loop need to know of an experiment.
+#[derive(Clone, Copy, Debug)]
+pub struct ExperimentEntry {
+    /// Its name, as [`Experiment::name`] gives it.
+    pub name: &'static str,
+    /// One line for documentation.
+    pub about: &'static str,
+    /// When it runs.
+    pub selection: Selection,
+    /// Builds it.
+    pub build: fn() -> Box<dyn Experiment>,
+}
+
 /// Every experiment, in report order.
+pub const EXPERIMENTS: &[ExperimentEntry] = &[
+    ExperimentEntry {
+        name: "profiles",
+        about: "every model's radial profile against the Monte Carlo reference (and MCML's)",
+        selection: Selection::Default,
+        build: || Box::new(profiles::ProfileComparison),
+    },
+    ExperimentEntry {
+        name: "scenes",
+        about: "every rendering method over its sweep on every scene, against the exact reference",
+        selection: Selection::Default,
+        build: || Box::new(scenes::SceneComparison),
+    },
+    ExperimentEntry {
+        name: "kernels",
+        about: "every separable kernel per material on synthetic frames: cost and error",
+        selection: Selection::Default,
+        build: || Box::new(kernels::KernelComparison),
+    },
+    ExperimentEntry {
+        name: "trees",
+        about: "Milaenen et al.'s claims at paper scale: the tree methods' error against time",
+        selection: Selection::Flag("trees"),
+        build: || Box::new(trees::TreeExperiment),
+    },
+    ExperimentEntry {
+        name: "manylight",
+        about: "Nabata & Iwasaki's claims at paper scale against a path-traced reference",
+        selection: Selection::Flag("manylight"),
+        build: || Box::new(manylight::ManyLightExperiment),
+    },
+];
+
+/// The experiments `config` selects, in report order: those whose flag it sets, or the
+/// default ones when it sets none.
 fn experiments(config: &Config) -> Vec<Box<dyn Experiment>> {
-    if config.paper_only() {
-        let mut v: Vec<Box<dyn Experiment>> = Vec::new();
-        if config.trees {
-            v.push(Box::new(trees::TreeExperiment));
-        }
-        if config.manylight {
-            v.push(Box::new(manylight::ManyLightExperiment));
-        }
-        return v;
-    }
-    vec![
-        Box::new(profiles::ProfileComparison),
-        Box::new(scenes::SceneComparison),
-        Box::new(kernels::KernelComparison),
-    ]
+    let flagged = |f: &str| match f {
+        "trees" => config.trees,
+        "manylight" => config.manylight,
+        _ => false,
+    };
+    EXPERIMENTS
+        .iter()
+        .filter(|e| match e.selection {
+            Selection::Default => !config.paper_only(),
+            Selection::Flag(f) => flagged(f),
+        })
+        .map(|e| (e.build)())
+        .collect()
 }
 
 fn check(config: &Config) -> Result<Vec<&'static Preset>, Error> {
@@ -325,4 +422,28 @@ fn assemble_report(
         s.push_str(&format!("## {}\n\n{}\n", sec.title, sec.body));
     }
     s
+}
+
+#[cfg(test)]
+mod registry_tests {
+    use super::*;
+
+    /// Each entry builds the experiment it names; a default run selects the three default
+    /// experiments in report order, a flag selects its experiment alone, and both flags both.
+    #[test]
+    fn the_registry_selects_by_flag() {
+        for e in EXPERIMENTS {
+            assert_eq!((e.build)().name(), e.name);
+        }
+        let names =
+            |c: &Config| -> Vec<&'static str> { experiments(c).iter().map(|e| e.name()).collect() };
+        let mut c = Config::new(vec!["skin1".into()], Vec::new(), PathBuf::from("x"));
+        assert_eq!(names(&c), ["profiles", "scenes", "kernels"]);
+        c.trees = true;
+        assert_eq!(names(&c), ["trees"]);
+        c.manylight = true;
+        assert_eq!(names(&c), ["trees", "manylight"]);
+        c.trees = false;
+        assert_eq!(names(&c), ["manylight"]);
+    }
 }

@@ -181,7 +181,7 @@ fn file_name(p: &Path) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::compare::checked::{sum_path, tests as t};
+    use crate::checked::{sum_path, tests as t};
 
     /// A 3×2 reference with distinct values in every pixel (all exact in f32, as the EXR
     /// stores them).
