@@ -21,7 +21,8 @@ wheels=target/pybind-wheels
 
 echo "== python bindings: cargo fmt, clippy"
 cargo fmt --manifest-path "$manifest" -- --check
-cargo clippy --manifest-path "$manifest" --all-targets -- -D warnings
+# Release, as the root's clippy: it reuses that check of the shared dependencies.
+cargo clippy --release --manifest-path "$manifest" --all-targets -- -D warnings
 
 sss="${SSS_BIN:-target/release/sss}"
 if [ ! -x "$sss" ]; then
