@@ -23,12 +23,8 @@ pub fn reference(xtask_help: &[(String, String)]) -> String {
         if title == "cargo xtask compare" {
             out.push_str(&experiments());
         }
-        out.push_str(&format!("## `{title}`\n\n```text\n"));
-        for line in help.trim_end().lines() {
-            out.push_str(line.trim_end());
-            out.push('\n');
-        }
-        out.push_str("```\n\n");
+        out.push_str(&format!("## `{title}`\n\n"));
+        sss_cli::reference::help_block(&mut out, help);
     }
     out.truncate(out.trim_end().len());
     out.push('\n');

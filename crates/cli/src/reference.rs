@@ -58,8 +58,9 @@ pub fn markdown() -> String {
     out
 }
 
-/// Appends `help` as a fenced text block, trailing spaces removed.
-fn help_block(out: &mut String, help: &str) {
+/// Appends `help` as a fenced text block, trailing spaces removed (also used by `cargo xtask
+/// docs` for its own help).
+pub fn help_block(out: &mut String, help: &str) {
     out.push_str("```text\n");
     for line in help.trim_end().lines() {
         out.push_str(line.trim_end());

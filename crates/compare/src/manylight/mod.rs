@@ -72,7 +72,6 @@ use reference::{Budget, Reference, path_reference};
 use report::*;
 use runs::*;
 use scoring::*;
-use sss_bssrdf::Rgb;
 use sss_manylight::Selection;
 use sss_plot::{PALETTE, Series, SeriesStyle, line_plot, write_error_map};
 use sss_render::frame::Frame;

@@ -4,12 +4,8 @@
 
 use super::*;
 
-/// Luminance weights (Rec. 709).
-pub(super) const LUM: [f64; 3] = sss_manylight::LUMINANCE;
-
-pub(super) fn lum(c: Rgb) -> f64 {
-    LUM[0] * c[0] + LUM[1] * c[1] + LUM[2] * c[2]
-}
+/// Luminance (Rec. 709), the scalar the estimators' error is controlled on.
+pub(super) use sss_util::luminance as lum;
 
 /// What a run's estimates score against the reference.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

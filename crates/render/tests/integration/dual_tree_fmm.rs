@@ -2,35 +2,16 @@
 //! determinism, and the paper's `dual-tree` pinned bit for bit to the values it gave before
 //! the local-expansion form was added.
 
+use crate::common::{irradiance, run, scene};
 use glam::DVec3;
 use sss_bssrdf::Rgb;
 use sss_bssrdf::{Medium, ModelKind, make_model};
 use sss_render::frame::Frame;
+use sss_render::integrators::Shaded;
 use sss_render::integrators::dual_tree::DualTree;
 use sss_render::integrators::dual_tree_fmm::{DualTreeFmm, LocalExpansion};
 use sss_render::integrators::exact::Exact;
-use sss_render::integrators::{Integrator, Shaded};
 use sss_render::irradiance::IrradianceSettings;
-use sss_render::progress::NoProgress;
-use sss_render::scene::{LoadOptions, Scene, builtin};
-
-fn scene(name: &str, w: u32, h: u32) -> Scene {
-    let mut s = builtin(name, &LoadOptions::default()).unwrap();
-    s.camera.width = w;
-    s.camera.height = h;
-    s
-}
-
-fn irradiance(spacing: f64) -> IrradianceSettings {
-    IrradianceSettings {
-        spacing_mfp: spacing,
-        ..IrradianceSettings::default()
-    }
-}
-
-fn run(frame: &Frame<'_>, m: &dyn Integrator) -> Shaded {
-    m.integrate(frame, &NoProgress).unwrap()
-}
 
 /// FNV-1a over the bits of every value, in G-buffer order.
 fn hash(values: &[Rgb]) -> u64 {

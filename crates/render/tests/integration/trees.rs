@@ -4,33 +4,14 @@
 //! clusters that do not make the dual tree worse than shading every pixel, and the directional
 //! dipole refused with an error naming the material.
 
+use crate::common::{irradiance, run, scene};
 use sss_bssrdf::Rgb;
 use sss_render::frame::Frame;
 use sss_render::integrators::dual_tree::DualTree;
 use sss_render::integrators::exact::Exact;
 use sss_render::integrators::single_tree::SingleTree;
 use sss_render::integrators::{Integrator, Shaded};
-use sss_render::irradiance::IrradianceSettings;
 use sss_render::progress::NoProgress;
-use sss_render::scene::{LoadOptions, Scene, builtin};
-
-fn scene(name: &str, w: u32, h: u32) -> Scene {
-    let mut s = builtin(name, &LoadOptions::default()).unwrap();
-    s.camera.width = w;
-    s.camera.height = h;
-    s
-}
-
-fn irradiance(spacing: f64) -> IrradianceSettings {
-    IrradianceSettings {
-        spacing_mfp: spacing,
-        ..IrradianceSettings::default()
-    }
-}
-
-fn run(frame: &Frame<'_>, m: &dyn Integrator) -> Shaded {
-    m.integrate(frame, &NoProgress).unwrap()
-}
 
 /// Largest relative difference per G-buffer sample and channel (relative to the largest value
 /// of the reference, so dark samples do not dominate), and the relative RMSE over samples.
