@@ -18,8 +18,8 @@
 
 use crate::fresnel::{fr_dielectric, fresnel_moment1, fresnel_moment2};
 use crate::profile_table::ProfileTable;
-use crate::spline_row::{OpticalProfile, SplineRow};
-use crate::{Bssrdf, Medium, ModelKind, Rgb};
+use crate::spline_row::{OpticalProfile, SplineRow, optical_profile_bssrdf};
+use crate::{Medium, ModelKind, Rgb};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -235,11 +235,11 @@ impl PbdTable {
 /// Photon beam diffusion for one [`Medium`], backed by the shared [`PbdTable`] of its (g, η)
 /// (pbrt 3rd ed. `TabulatedBSSRDF` with the table of `ComputeBeamDiffusionBSSRDF`).
 ///
-/// - [`Bssrdf::rd`] is σ_t² times the table spline at (ρ, r σ_t) divided by 2π r σ_t
+/// - [`Bssrdf::rd`](crate::Bssrdf::rd) is σ_t² times the table spline at (ρ, r σ_t) divided by 2π r σ_t
 ///   (pbrt Eq. 11.10), clamped to ≥ 0, and 0 beyond the table's ≈ 204 mean free paths.
-/// - [`Bssrdf::total_diffuse_reflectance`] is the interpolated effective albedo.
-/// - [`Bssrdf::sample_sr`] inverts the CDF of the interpolated spline (the algorithm of
-///   [`crate::catmull_rom::sample_catmull_rom_2d`]) and [`Bssrdf::pdf_sr`] is its exact
+/// - [`Bssrdf::total_diffuse_reflectance`](crate::Bssrdf::total_diffuse_reflectance) is the interpolated effective albedo.
+/// - [`Bssrdf::sample_sr`](crate::Bssrdf::sample_sr) inverts the CDF of the interpolated spline (the algorithm of
+///   [`crate::catmull_rom::sample_catmull_rom_2d`]) and [`Bssrdf::pdf_sr`](crate::Bssrdf::pdf_sr) is its exact
 ///   density per unit radius, spline · σ_t / ∫spline (pbrt's `Pdf_Sr` is the per-area
 ///   density; ours is multiplied by 2πr). Where the spline dips below 0 between two knots
 ///   (the far tail at albedo → 1 for g = 0.9, up to 1.5·10⁻⁴ of the mass) pbrt's pair is
@@ -297,51 +297,12 @@ impl PhotonBeamDiffusion {
     }
 }
 
-impl Bssrdf for PhotonBeamDiffusion {
-    fn kind(&self) -> ModelKind {
-        ModelKind::PhotonBeamDiffusion
-    }
-
-    fn medium(&self) -> &Medium {
-        &self.medium
-    }
-
-    fn rd(&self, ch: usize, r: f64) -> f64 {
-        self.profile.rd(ch, r)
-    }
-
-    fn rd_rgb(&self, r: f64) -> Rgb {
-        self.profile.rd_rgb(r)
-    }
-
-    /// The derivatives of the blended Catmull-Rom spline
-    /// ([`OpticalProfile::rd_derivatives`]).
-    fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {
-        self.profile.rd_derivatives(ch, r.abs())
-    }
-
-    fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
-        self.effective_albedo(ch)
-    }
-
-    fn sample_sr(&self, ch: usize, u: f64) -> f64 {
-        self.profile.sample_sr(ch, u)
-    }
-
-    fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
-        self.profile.pdf_sr(ch, r)
-    }
-
-    /// Inverts the interpolated row CDF: the same spline inversion as [`Bssrdf::sample_sr`]
-    /// (pbrt uses `Sample_Sr(ch, 0.999)` for its probe radius the same way).
-    fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64 {
-        self.sample_sr(ch, fraction)
-    }
-}
+optical_profile_bssrdf!(PhotonBeamDiffusion, ModelKind::PhotonBeamDiffusion);
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Bssrdf;
     use crate::quadrature::{integrate_radial, integrate_radial_range};
     use rand::{RngExt, SeedableRng};
     use rand_pcg::Pcg64Mcg;

@@ -607,6 +607,61 @@ mod tests {
     }
 }
 
+/// Implements [`crate::Bssrdf`] for a tabulated model, once for all of them (pbrt 3rd ed.'s
+/// `TabulatedBSSRDF`, §11.4.2): `$model` has fields `medium: Medium` and `profile:
+/// OpticalProfile` and an inherent `effective_albedo(ch)`, and is of kind `$kind`. R_d, its
+/// derivatives, sampling and density are the [`OpticalProfile`]'s; the total diffuse
+/// reflectance is the effective albedo; the radius holding a fraction of the energy inverts
+/// the same row CDF as `sample_sr` (pbrt uses `Sample_Sr(ch, 0.999)` for its probe radius the
+/// same way).
+macro_rules! optical_profile_bssrdf {
+    ($model:ty, $kind:expr) => {
+        impl $crate::Bssrdf for $model {
+            fn kind(&self) -> $crate::ModelKind {
+                $kind
+            }
+
+            fn medium(&self) -> &$crate::Medium {
+                &self.medium
+            }
+
+            fn rd(&self, ch: usize, r: f64) -> f64 {
+                self.profile.rd(ch, r)
+            }
+
+            fn rd_rgb(&self, r: f64) -> $crate::Rgb {
+                self.profile.rd_rgb(r)
+            }
+
+            /// The derivatives of the blended Catmull-Rom spline
+            /// ([`crate::spline_row::OpticalProfile::rd_derivatives`]).
+            fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {
+                self.profile.rd_derivatives(ch, r.abs())
+            }
+
+            fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
+                self.effective_albedo(ch)
+            }
+
+            fn sample_sr(&self, ch: usize, u: f64) -> f64 {
+                self.profile.sample_sr(ch, u)
+            }
+
+            fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
+                self.profile.pdf_sr(ch, r)
+            }
+
+            /// Inverts the interpolated row CDF: the same spline inversion as
+            /// [`crate::Bssrdf::sample_sr`] (pbrt uses `Sample_Sr(ch, 0.999)` for its probe
+            /// radius the same way).
+            fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64 {
+                self.profile.sample_sr(ch, fraction)
+            }
+        }
+    };
+}
+pub(crate) use optical_profile_bssrdf;
+
 /// The radial profile of a tabulated model in optical units, per channel: R_d(r) =
 /// σ_t² T(σ_t r)/(2π) from a blended row T, sampled from the row made non-negative, with the
 /// exponential σ_t e^{−σ_t r} where a channel has no tabulated mass. Photon beam diffusion and

@@ -2,6 +2,8 @@
 //! comparable, so `results.csv` records the host of every row and a merged report flags rows
 //! from more than one host.
 
+use super::output::csv_text;
+
 /// A machine: its CPU model and logical cores.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Host {
@@ -22,7 +24,7 @@ impl Host {
             .unwrap_or_else(|| "unknown".to_string());
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         Host {
-            cpu: field(&cpu),
+            cpu: csv_text(&cpu),
             cores,
         }
     }
@@ -45,15 +47,6 @@ fn cpu_model(cpuinfo: &str) -> Option<String> {
         })
 }
 
-/// `text` as one CSV or TSV field: commas, tabs and line breaks become spaces, runs of spaces
-/// one space.
-pub fn field(text: &str) -> String {
-    text.replace([',', '\t', '\n', '\r'], " ")
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -63,7 +56,6 @@ mod tests {
         let text = "processor\t: 0\nvendor_id\t: GenuineIntel\nmodel name\t: Intel(R) Xeon(R), 2.9GHz\n\
                     processor\t: 1\nmodel name\t: other\n";
         assert_eq!(cpu_model(text).as_deref(), Some("Intel(R) Xeon(R), 2.9GHz"));
-        assert_eq!(field("Intel(R) Xeon(R), 2.9GHz"), "Intel(R) Xeon(R) 2.9GHz");
         assert_eq!(cpu_model("processor : 0\n"), None);
         assert_eq!(
             cpu_model("Hardware : BCM2835\n").as_deref(),

@@ -15,6 +15,10 @@
 //!    experiments, by their flags.
 //! 3. `report.md` is assembled from the sections.
 //!
+//! Each experiment is a module of its own, split by concern (its plan, runs, scoring, plots
+//! or images, and report), and every CSV it writes goes through one writer (module `output`),
+//! so every file formats its numbers, cleans its text fields and ends its lines the same way.
+//!
 //! Everything random is seeded ([`Config::seed`]), so error figures are reproducible; only
 //! the timings vary from run to run.
 //!
@@ -48,8 +52,6 @@ mod checked;
 mod host;
 mod kernels;
 mod manylight;
-mod mcml;
-mod metrics;
 mod output;
 mod profiles;
 mod reference;

@@ -1,6 +1,8 @@
-//! Writing outputs: atomic file writes and number formatting for the report.
+//! Writing outputs: atomic file writes, the one CSV writer every experiment's table goes
+//! through, and number formatting for the report.
 
 use super::Error;
+use std::fmt::Display;
 use std::path::Path;
 
 /// Writes `bytes` to a temporary file next to `path` and renames it into place, so a reader
@@ -17,6 +19,87 @@ pub fn csv_num(v: Option<f64>) -> String {
         Some(x) if x.is_finite() => format!("{x:e}"),
         _ => String::new(),
     }
+}
+
+/// One CSV file being built: a header line, then rows of exactly as many fields, each line
+/// ended by `\n`. Every experiment writes its CSV through this type, with numbers from
+/// [`csv_num`] and text from [`csv_text`], so every file formats, cleans and ends its lines
+/// the same way and none can have a row of the wrong width.
+#[derive(Clone, Debug)]
+pub struct Csv {
+    columns: usize,
+    text: String,
+}
+
+impl Csv {
+    /// A file with these column names (written as given: names are the crate's own
+    /// identifiers, never user text).
+    pub fn new<S: AsRef<str>>(columns: impl IntoIterator<Item = S>) -> Self {
+        let names: Vec<String> = columns
+            .into_iter()
+            .map(|c| c.as_ref().to_string())
+            .collect();
+        let mut text = names.join(",");
+        text.push('\n');
+        Csv {
+            columns: names.len(),
+            text,
+        }
+    }
+
+    /// Appends one row. Its width must be the header's: a row of another width is a bug in
+    /// the experiment that builds it, never a property of the input, so it panics.
+    pub fn row(&mut self, fields: impl IntoIterator<Item = String>) {
+        let fields: Vec<String> = fields.into_iter().collect();
+        assert_eq!(
+            fields.len(),
+            self.columns,
+            "a CSV row of {} fields under a header of {}",
+            fields.len(),
+            self.columns
+        );
+        self.text.push_str(&fields.join(","));
+        self.text.push('\n');
+    }
+
+    /// Writes the file atomically ([`write_atomic`]).
+    pub fn write(&self, path: &Path) -> Result<(), Error> {
+        write_atomic(path, self.text.as_bytes())
+    }
+}
+
+impl From<Csv> for String {
+    /// The file's text.
+    fn from(csv: Csv) -> String {
+        csv.text
+    }
+}
+
+/// The columns of `csv`'s header that `docs/compare.md` does not name (in backticks): every
+/// experiment's tests keep its CSV documented with this.
+#[cfg(test)]
+pub fn undocumented(csv: &Csv) -> Vec<String> {
+    let path = crate::workspace_root().join("docs/compare.md");
+    let doc = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("cannot read '{}': {e}", path.display()));
+    csv.text
+        .lines()
+        .next()
+        .unwrap_or("")
+        .split(',')
+        .filter(|c| !doc.contains(&format!("`{c}`")))
+        .map(String::from)
+        .collect()
+}
+
+/// `text` as one CSV (or TSV) field: commas, tabs and line breaks become spaces, and runs of
+/// spaces one space, so a name from a scene file or a CPU's model string cannot split a row.
+pub fn csv_text(text: impl Display) -> String {
+    text.to_string()
+        .replace([',', '\t', '\n', '\r'], " ")
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// A number for a Markdown table with `sig` significant digits; `–` when missing.
@@ -74,6 +157,27 @@ mod tests {
         assert_eq!(md_num(Some(1.5e-7), 3), "1.50e-7");
         assert_eq!(md_num(None, 3), "–");
         assert_eq!(md_pct(Some(0.1234)), "12.3 %");
+    }
+
+    #[test]
+    fn csv_rows_follow_the_header() {
+        let mut csv = Csv::new(["name", "value"]);
+        csv.row([csv_text("a, b\tc\n"), csv_num(Some(2.0))]);
+        csv.row([csv_text(7), csv_num(None)]);
+        assert_eq!(String::from(csv), "name,value\na b c,2e0\n7,\n");
+        assert_eq!(csv_text("  Intel(R), 2.9GHz "), "Intel(R) 2.9GHz");
+    }
+
+    #[test]
+    fn undocumented_columns_are_found() {
+        let csv = Csv::new(["rmse", "no_such_column_anywhere"]);
+        assert_eq!(undocumented(&csv), ["no_such_column_anywhere"]);
+    }
+
+    #[test]
+    #[should_panic(expected = "a CSV row of 1 fields under a header of 2")]
+    fn a_row_of_another_width_is_refused() {
+        Csv::new(["name", "value"]).row([csv_text("a")]);
     }
 
     #[test]

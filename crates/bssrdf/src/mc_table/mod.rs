@@ -64,7 +64,7 @@
 //! # The far tail: a fitted diffusion far field
 //! Measured against MCML (Wang, Jacques & Zheng, *MCML — Monte Carlo modeling of light
 //! transport in multi-layered tissues*, Comput. Methods Programs Biomed. 47, 1995; 12 media
-//! of reduced albedo 0.68–0.9999, `tests/mcml.rs`, its `stages` test prints the figures) on
+//! of reduced albedo 0.68–0.9999, `tests/integration/mcml.rs`, its `stages` test prints the figures) on
 //! the table's own bins, the tallies, the pooling, the isotonic fit, the histopolation and
 //! the albedo blend all agree with MCML within the tallies' noise up to ≈ 10 mean free paths
 //! (worst −4.3 % at 8 mean free paths for ketchup, 2.6 of the tallies' standard errors);
@@ -87,7 +87,7 @@
 //! and σ_tr = 0.87; Case & Zweifel, *Linear Transport Theory*, 1967, §4). Its bin integrals
 //! are closed-form. The replaced bins keep their tallied light, so every row's total is
 //! unchanged. After it, every MCML case is within 3 % + 3 standard errors up to
-//! 10 mean free paths and 10 % + 3 standard errors up to 16 (see `tests/mcml.rs` for the
+//! 10 mean free paths and 10 % + 3 standard errors up to 16 (see `tests/integration/mcml.rs` for the
 //! margins and how MCML's noise is treated); evaluation is unchanged, and building a table
 //! costs one small fit per row.
 //!

@@ -4,22 +4,22 @@
 
 use super::*;
 use crate::catmull_rom::{apply_weights, catmull_rom_weights};
-use crate::spline_row::{OpticalProfile, SplineRow};
-use crate::{Bssrdf, Medium, ModelKind, Rgb};
+use crate::spline_row::{OpticalProfile, SplineRow, optical_profile_bssrdf};
+use crate::{Medium, ModelKind, Rgb};
 use std::sync::Arc;
 
 /// The `mc-table` model for one [`Medium`]: the random walk's profile from the shared
 /// [`McTable`] of its η and g, scaled to its reduced extinction.
 ///
 /// - With σ'_t = σ_a + σ_s(1 − g) and ρ' = σ_s(1 − g)/σ'_t (the tables' reduced units, see
-///   the module documentation), [`Bssrdf::rd`] is σ'_t² times the table row blended at ρ',
+///   the module documentation), [`Bssrdf::rd`](crate::Bssrdf::rd) is σ'_t² times the table row blended at ρ',
 ///   evaluated at x = rσ'_t and divided by 2πx, clamped to ≥ 0, and 0 beyond the table's
 ///   last knot. The row's first interval [0, 0.0005] is linear in 2πx R_d
 ///   ([`SplineRow::with_linear_first_segment`]): R_d is constant there instead of bumping.
-/// - [`Bssrdf::total_diffuse_reflectance`] is the row's integral (the interpolated effective
+/// - [`Bssrdf::total_diffuse_reflectance`](crate::Bssrdf::total_diffuse_reflectance) is the row's integral (the interpolated effective
 ///   albedo up to that first interval, ≈ 10⁻⁵ of it), clamped to [0, 1].
-/// - [`Bssrdf::sample_sr`] inverts the CDF of the non-negative row
-///   ([`SplineRow::non_negative`]) and [`Bssrdf::pdf_sr`] is its exact density, as for
+/// - [`Bssrdf::sample_sr`](crate::Bssrdf::sample_sr) inverts the CDF of the non-negative row
+///   ([`SplineRow::non_negative`]) and [`Bssrdf::pdf_sr`](crate::Bssrdf::pdf_sr) is its exact density, as for
 ///   [`crate::PhotonBeamDiffusion`]; a channel without tabulated mass (ρ' = 0) samples
 ///   σ'_t e^{−σ'_t r}.
 #[derive(Clone, Debug)]
@@ -119,43 +119,4 @@ fn monotone_row(table: &McTable, rho: f64) -> Option<SplineRow> {
     Some(SplineRow::new(table.index(), &values).monotone_over_x())
 }
 
-impl Bssrdf for McTableModel {
-    fn kind(&self) -> ModelKind {
-        ModelKind::McTable
-    }
-
-    fn medium(&self) -> &Medium {
-        &self.medium
-    }
-
-    fn rd(&self, ch: usize, r: f64) -> f64 {
-        self.profile.rd(ch, r)
-    }
-
-    fn rd_rgb(&self, r: f64) -> Rgb {
-        self.profile.rd_rgb(r)
-    }
-
-    /// The derivatives of the blended Catmull-Rom spline
-    /// ([`OpticalProfile::rd_derivatives`]).
-    fn rd_derivatives(&self, ch: usize, r: f64) -> (f64, f64, f64) {
-        self.profile.rd_derivatives(ch, r.abs())
-    }
-
-    fn total_diffuse_reflectance(&self, ch: usize) -> f64 {
-        self.effective_albedo(ch)
-    }
-
-    fn sample_sr(&self, ch: usize, u: f64) -> f64 {
-        self.profile.sample_sr(ch, u)
-    }
-
-    fn pdf_sr(&self, ch: usize, r: f64) -> f64 {
-        self.profile.pdf_sr(ch, r)
-    }
-
-    /// Inverts the row's CDF, as [`Bssrdf::sample_sr`].
-    fn radius_for_energy(&self, ch: usize, fraction: f64) -> f64 {
-        self.sample_sr(ch, fraction)
-    }
-}
+optical_profile_bssrdf!(McTableModel, ModelKind::McTable);

@@ -16,7 +16,7 @@
 //! collision); photon beam diffusion, normalized diffusion, `mc-table` and the directional
 //! dipole against the full tally (the directional dipole puts a source of strength 1, not α′, at the ray's
 //! first scattering event — Frisvad et al. 2014, Eq. 20 — so it stands for all scattered light;
-//! `McPart::All` in crates/compare/src/profiles.rs).
+//! `McPart::All` in crates/compare/src/profiles/registry.rs).
 //!
 //! # Margins
 //! The simulation is seeded ([`SEED`]) and bit-identical for any thread count, so every value

@@ -63,7 +63,7 @@ mod scoring;
 #[cfg(test)]
 mod tests;
 
-use super::output::{csv_num, md_num, md_table, write_atomic};
+use super::output::{Csv, csv_num, csv_text, md_num, md_table};
 use super::{Context, Error, Experiment, Section};
 use equal::{Reach, error_at_time, extrapolated_time, time_to_reach};
 use plan::*;
@@ -308,7 +308,7 @@ impl Experiment for ManyLightExperiment {
             }
             refs.push((name, r, tri));
         }
-        write_atomic(&cfg.out.join("manylight.csv"), csv(&rows).as_bytes())?;
+        csv(&rows).write(&cfg.out.join("manylight.csv"))?;
         plots(ctx, &rows, &p)?;
         Ok(report(&rows, &refs, &skipped, &p))
     }

@@ -3,36 +3,51 @@
 
 use super::*;
 
-pub(super) fn csv(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "scene,experiment,method,selection,eps,points,vpls,triangles,seed,seconds,pixels,\
-         mean_triplets,accuracy,rmse,bias,bias_se,capped,floored\n",
-    );
+/// `manylight.csv`: one row per run.
+pub(super) fn csv(rows: &[Row]) -> Csv {
+    let mut csv = Csv::new([
+        "scene",
+        "experiment",
+        "method",
+        "selection",
+        "eps",
+        "points",
+        "vpls",
+        "triangles",
+        "seed",
+        "seconds",
+        "pixels",
+        "mean_triplets",
+        "accuracy",
+        "rmse",
+        "bias",
+        "bias_se",
+        "capped",
+        "floored",
+    ]);
     for r in rows {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            r.scene,
-            r.experiment,
-            r.method,
-            r.selection,
-            r.eps,
-            r.points,
-            r.vpls,
-            r.triangles,
-            r.seed,
+        csv.row([
+            csv_text(r.scene),
+            csv_text(r.experiment),
+            csv_text(r.method),
+            csv_text(r.selection),
+            csv_text(r.eps),
+            csv_text(r.points),
+            csv_text(r.vpls),
+            csv_text(r.triangles),
+            csv_text(r.seed),
             csv_num(Some(r.seconds)),
-            r.pixels,
+            csv_text(r.pixels),
             csv_num(Some(r.mean_triplets)),
             csv_num(Some(r.accuracy)),
             csv_num(Some(r.rmse)),
             csv_num(Some(r.bias)),
             csv_num(Some(r.bias_se)),
-            r.capped,
-            r.floored
-        );
+            csv_text(r.capped),
+            csv_text(r.floored),
+        ]);
     }
-    s
+    csv
 }
 
 /// Ours at the fixed ε on `scene`: (seconds, RMSE), means over the streams.

@@ -222,3 +222,9 @@ fn table1_reads_equal_quality_and_time_off_the_sweeps() {
     assert!(t.contains("outside its runs (4.00–16.0 s)"), "{t}");
     assert!(t.contains("≤ 3.00 (its cheapest run)"), "{t}");
 }
+
+/// Every column of the experiment's CSV is documented in `docs/compare.md`.
+#[test]
+fn every_csv_column_is_documented() {
+    assert_eq!(crate::output::undocumented(&csv(&[])), Vec::<String>::new());
+}

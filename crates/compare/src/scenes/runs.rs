@@ -5,13 +5,12 @@
 
 use super::super::Error;
 use super::super::host::Host;
-use super::super::output::csv_num;
+use super::super::output::{Csv, csv_num, csv_text};
 use sss_render::integrators::Integrator;
 use sss_render::integrators::METHODS;
 use sss_render::progress::NoProgress;
 use sss_render::scene::Scene;
 use sss_render::{RenderOutput, RenderSettings, Stage, render};
-use std::fmt::Write as _;
 
 /// Stages every render reports first, in order.
 const LEADING: [&str; 3] = ["bvh", "gbuffer", "models"];
@@ -73,47 +72,62 @@ impl Run {
     }
 }
 
-/// The header of `results.csv` (documented in `docs/compare.md`).
-pub fn csv_header(stages: &[&str]) -> String {
-    let mut h = String::from("scene,method,param,value,threads,host,host_cores,seconds_total");
-    for s in stages {
-        let _ = write!(h, ",seconds_{s}");
-    }
-    h.push_str(",rmse,rel_rmse,frac_within_eps,frac_within_3se,mean_ratio,warnings\n");
-    h
+/// The columns of `results.csv` (documented in `docs/compare.md`).
+pub fn csv_columns(stages: &[&str]) -> Vec<String> {
+    let mut cols: Vec<String> = [
+        "scene",
+        "method",
+        "param",
+        "value",
+        "threads",
+        "host",
+        "host_cores",
+        "seconds_total",
+    ]
+    .map(String::from)
+    .to_vec();
+    cols.extend(stages.iter().map(|s| format!("seconds_{s}")));
+    cols.extend(
+        [
+            "rmse",
+            "rel_rmse",
+            "frac_within_eps",
+            "frac_within_3se",
+            "mean_ratio",
+            "warnings",
+        ]
+        .map(String::from),
+    );
+    cols
 }
 
-pub fn csv_rows(runs: &[Run]) -> String {
+/// `results.csv`: one row per run.
+pub fn results_csv(runs: &[Run]) -> Csv {
     let stages = stage_columns(runs);
-    let mut s = csv_header(&stages);
+    let mut csv = Csv::new(csv_columns(&stages));
     for r in runs {
-        let _ = write!(
-            s,
-            "{},{},{},{},{},{},{},{}",
-            r.scene,
-            r.method,
-            r.param,
+        let mut row = vec![
+            csv_text(&r.scene),
+            csv_text(r.method),
+            csv_text(r.param),
             csv_num(Some(r.value)),
-            r.threads,
-            r.host.cpu,
-            r.host.cores,
-            csv_num(Some(r.seconds_total()))
-        );
-        for st in &stages {
-            let _ = write!(s, ",{}", csv_num(r.stage(st)));
-        }
-        let _ = writeln!(
-            s,
-            ",{},{},{},{},{},{}",
+            csv_text(r.threads),
+            csv_text(&r.host.cpu),
+            csv_text(r.host.cores),
+            csv_num(Some(r.seconds_total())),
+        ];
+        row.extend(stages.iter().map(|st| csv_num(r.stage(st))));
+        row.extend([
             csv_num(Some(r.rmse)),
             csv_num(Some(r.rel_rmse)),
             csv_num(Some(r.frac_within_eps)),
             csv_num(r.within_3se),
             csv_num(Some(r.mean_ratio)),
-            r.warnings.len()
-        );
+            csv_text(r.warnings.len()),
+        ]);
+        csv.row(row);
     }
-    s
+    csv
 }
 
 /// What one unit of the sweep gave: its runs (all threads first, then one thread where the
@@ -374,7 +388,7 @@ mod tests {
                 "bvh", "gbuffer", "models", "samples", "trees", "shading", "opaque"
             ]
         );
-        let csv = csv_rows(&more);
+        let csv = String::from(results_csv(&more));
         let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
         let row: Vec<&str> = csv.lines().nth(2).unwrap().split(',').collect();
         assert_eq!(header.len(), row.len());
@@ -386,7 +400,7 @@ mod tests {
 
     #[test]
     fn csv_header_has_the_documented_columns() {
-        let h = csv_header(&stage_columns(&[]));
+        let h = csv_columns(&stage_columns(&[]));
         for col in [
             "scene",
             "method",
@@ -400,10 +414,7 @@ mod tests {
             "frac_within_eps",
             "warnings",
         ] {
-            assert!(
-                h.split(',').any(|c| c.trim() == col),
-                "{col} missing from {h}"
-            );
+            assert!(h.iter().any(|c| c == col), "{col} missing from {h:?}");
         }
     }
 

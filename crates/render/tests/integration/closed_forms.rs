@@ -7,6 +7,7 @@
 //! intersections, Fresnel equations, Lambert's polygon formula); the code under test is only
 //! called to produce the value being checked.
 
+use super::common::{diffuse, scene_of};
 use glam::DVec3;
 use sss_bssrdf::{Medium, ModelKind, make_model};
 use sss_render::gbuffer::{GBuffer, GSample};
@@ -16,7 +17,7 @@ use sss_render::irradiance::IrradianceSettings;
 use sss_render::lights::{Incident, Receiver, gather};
 use sss_render::progress::NoProgress;
 use sss_render::rng::{Stream, rng};
-use sss_render::scene::{Camera, Light, Material, MaterialKind, Mesh, Object, Scene, Translucent};
+use sss_render::scene::{Camera, Light, Material, MaterialKind, Mesh, Scene, Translucent};
 use sss_render::{RenderSettings, render};
 use std::f64::consts::PI;
 
@@ -51,37 +52,6 @@ fn rect(centre: DVec3, u: DVec3, v: DVec3, half_u: f64, half_v: f64, n: u32) -> 
         positions,
         normals,
         triangles,
-    }
-}
-
-fn diffuse() -> Material {
-    Material {
-        name: "grey".into(),
-        kind: MaterialKind::Diffuse {
-            albedo: [0.5; 3],
-            texture: None,
-        },
-    }
-}
-
-fn scene_of(meshes: Vec<Mesh>, material: Material, lights: Vec<Light>, camera: Camera) -> Scene {
-    Scene {
-        name: "closed-forms".into(),
-        path: None,
-        camera,
-        lights,
-        materials: vec![material],
-        objects: meshes
-            .into_iter()
-            .enumerate()
-            .map(|(i, mesh)| Object {
-                name: format!("object{i}"),
-                material: 0,
-                mesh,
-                curvature: None,
-            })
-            .collect(),
-        warnings: Vec::new(),
     }
 }
 

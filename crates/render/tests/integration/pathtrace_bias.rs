@@ -19,6 +19,7 @@
 //! the signed mean below averages over enough samples per run for the standardised error to be
 //! near-normal.
 
+use super::common::{scene_with, square, translucent, uv_sphere};
 use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::{Medium, ModelKind, make_model};
@@ -30,7 +31,7 @@ use sss_render::integrators::{METHODS, MethodOptions};
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::progress::NoProgress;
 use sss_render::rng::{Stream, rng};
-use sss_render::scene::{Camera, Light, Material, MaterialKind, Mesh, Object, Scene, Translucent};
+use sss_render::scene::{Camera, Light, MaterialKind, Object, Scene};
 use sss_render::shading::TranslucentShading;
 use sss_render::{RenderOutput, RenderSettings, render};
 use std::f64::consts::PI;
@@ -39,43 +40,6 @@ const LIGHT: DVec3 = DVec3::new(3.0, 2.0, 3.0);
 /// Shadowed pixels kept: the surface point lies at least this far (scene units, along the
 /// unit sphere) beyond the terminator of the point light.
 const MIN_SHADOW_DEPTH: f64 = 0.15;
-
-/// A UV sphere of `rings` × `segments` quads, outward normals.
-fn uv_sphere(radius: f64, rings: u32, segments: u32) -> Mesh {
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    for i in 0..=rings {
-        let theta = PI * i as f64 / rings as f64;
-        for j in 0..segments {
-            let phi = 2.0 * PI * j as f64 / segments as f64;
-            let n = DVec3::new(
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                theta.sin() * phi.sin(),
-            );
-            positions.push(n * radius);
-            normals.push(n);
-        }
-    }
-    let mut triangles = Vec::new();
-    let idx = |i: u32, j: u32| i * segments + (j % segments);
-    for i in 0..rings {
-        for j in 0..segments {
-            let (a, b, c, d) = (idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1));
-            if i != 0 {
-                triangles.push([a, b, c]);
-            }
-            if i + 1 != rings {
-                triangles.push([b, d, c]);
-            }
-        }
-    }
-    Mesh {
-        positions,
-        normals,
-        triangles,
-    }
-}
 
 /// The sphere of render.rs's `pathtrace_agrees_with_exact_on_a_sphere`: skin1 at 10 mm per
 /// scene unit on a unit sphere, one point light, 24 × 24 pixels.
@@ -96,19 +60,11 @@ fn scene() -> Scene {
             position: LIGHT,
             intensity: [10.0; 3],
         }],
-        materials: vec![Material {
-            name: "skin1".into(),
-            kind: MaterialKind::Translucent(Translucent {
-                model: ModelKind::BetterDipole,
-                medium: Medium::preset("skin1").unwrap(),
-                units_per_mm: 0.1,
-                texture: None,
-            }),
-        }],
+        materials: vec![translucent(ModelKind::BetterDipole, "skin1", 0.1)],
         objects: vec![Object {
             name: "sphere".into(),
             material: 0,
-            mesh: uv_sphere(1.0, 48, 96),
+            mesh: uv_sphere(DVec3::ZERO, 1.0, 48, 96),
             curvature: None,
         }],
         warnings: Vec::new(),
@@ -376,37 +332,20 @@ fn probe_energy_outside_the_unit_interval_is_refused() {
 fn pathtrace_matches_the_flat_slab_closed_form() {
     use sss_bssrdf::fresnel::ft_dielectric;
     use sss_bssrdf::fresnel_normalization;
-    let n = 8u32;
     let size = 100.0;
-    let mut positions = Vec::new();
-    for i in 0..=n {
-        for j in 0..=n {
-            let x = -size / 2.0 + size * j as f64 / n as f64;
-            let z = -size / 2.0 + size * i as f64 / n as f64;
-            positions.push(DVec3::new(x, 0.0, z));
-        }
-    }
-    let mut triangles = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            let a = i * (n + 1) + j;
-            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
-            // (c − a) × (b − a) = z × x = +y: facing up.
-            triangles.push([a, c, b]);
-            triangles.push([b, c, d]);
-        }
-    }
     let e0 = [2.0, 1.0, 0.5];
-    let translucent = Translucent {
-        model: ModelKind::BetterDipole,
-        medium: Medium::preset("skin1").unwrap(),
-        units_per_mm: 1.0,
-        texture: None,
+    let material = translucent(ModelKind::BetterDipole, "skin1", 1.0);
+    let MaterialKind::Translucent(skin1) = material.kind.clone() else {
+        unreachable!("a translucent material")
     };
-    let sc = Scene {
-        name: "slab".into(),
-        path: None,
-        camera: Camera {
+    let sc = scene_with(
+        square(size, 8),
+        material,
+        vec![Light::Directional {
+            direction: DVec3::NEG_Y,
+            irradiance: e0,
+        }],
+        Camera {
             position: DVec3::new(0.0, 60.0, 0.0),
             target: DVec3::ZERO,
             up: DVec3::Z,
@@ -415,31 +354,12 @@ fn pathtrace_matches_the_flat_slab_closed_form() {
             height: 5,
             pixel_samples: 1,
         },
-        lights: vec![Light::Directional {
-            direction: DVec3::NEG_Y,
-            irradiance: e0,
-        }],
-        materials: vec![Material {
-            name: "skin1".into(),
-            kind: MaterialKind::Translucent(translucent.clone()),
-        }],
-        objects: vec![Object {
-            name: "slab".into(),
-            material: 0,
-            mesh: Mesh {
-                normals: vec![DVec3::Y; positions.len()],
-                positions,
-                triangles,
-            },
-            curvature: None,
-        }],
-        warnings: Vec::new(),
-    };
+    );
     let geom = SceneGeometry::new(&sc);
     let gb = GBuffer::new(&sc, &geom, 0);
     let g = gb.pixel(2 * 5 + 2)[0];
     assert!((g.p - DVec3::ZERO).length() < 1e-9 && (g.n - DVec3::Y).length() < 1e-12);
-    let shading = TranslucentShading::new("skin1", &translucent);
+    let shading = TranslucentShading::new("skin1", &skin1);
     let radii = ProbeRadii::new(&shading, DEFAULT_PROBE);
     assert!(
         radii.rmax.iter().all(|r| *r < size / 2.0),
@@ -463,8 +383,8 @@ fn pathtrace_matches_the_flat_slab_closed_form() {
             s2[c] += v[c] * v[c];
         }
     }
-    let model = make_model(ModelKind::BetterDipole, &translucent.medium);
-    let eta = translucent.medium.eta();
+    let model = make_model(ModelKind::BetterDipole, &skin1.medium);
+    let eta = skin1.medium.eta();
     let ft = ft_dielectric(1.0, eta);
     let k = samples as f64;
     for c in 0..3 {

@@ -4,6 +4,7 @@
 //! pixels, then flattened) against a per-pixel loop over the camera's samples, for several
 //! thread counts.
 
+use super::common::{diffuse, scene_of};
 use glam::DVec3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -11,7 +12,7 @@ use sss_hierarchy::intersect_triangle;
 use sss_render::camera::{CameraFrame, pixel_samples};
 use sss_render::gbuffer::{GBuffer, GSample};
 use sss_render::geometry::SceneGeometry;
-use sss_render::scene::{Camera, Material, MaterialKind, Mesh, Object, Scene};
+use sss_render::scene::{Camera, Mesh, Scene};
 
 /// A mesh of the given triangles (each with its own three vertices) and random unit normals.
 fn soup(tris: &[[DVec3; 3]], rng: &mut Pcg64Mcg) -> Mesh {
@@ -97,10 +98,11 @@ fn scene(width: u32, height: u32, spp: u32) -> Scene {
         soup(&[sliver, SHARED], &mut rng),
         soup(&grid(-0.2, 2.0, 3), &mut rng),
     ];
-    Scene {
-        name: "ray-casting".into(),
-        path: None,
-        camera: Camera {
+    scene_of(
+        meshes,
+        diffuse(),
+        Vec::new(),
+        Camera {
             position: DVec3::new(0.4, 2.5, 6.0),
             target: DVec3::new(0.0, 0.0, 0.0),
             up: DVec3::Y,
@@ -109,26 +111,7 @@ fn scene(width: u32, height: u32, spp: u32) -> Scene {
             height,
             pixel_samples: spp,
         },
-        lights: Vec::new(),
-        materials: vec![Material {
-            name: "grey".into(),
-            kind: MaterialKind::Diffuse {
-                albedo: [0.5; 3],
-                texture: None,
-            },
-        }],
-        objects: meshes
-            .into_iter()
-            .enumerate()
-            .map(|(i, mesh)| Object {
-                name: format!("object{i}"),
-                material: 0,
-                mesh,
-                curvature: None,
-            })
-            .collect(),
-        warnings: Vec::new(),
-    }
+    )
 }
 
 /// A brute-force hit: (object, triangle, t, u, v).

@@ -1,6 +1,7 @@
 //! End-to-end tests of the two references on scenes built in code: the flat-slab closed form,
 //! agreement of `pathtrace` with `exact`, determinism, and the irradiance samples' invariants.
 
+use super::common::{scene_with, square, translucent, uv_sphere};
 use glam::DVec3;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{Medium, ModelKind, fresnel_normalization, make_model};
@@ -10,104 +11,9 @@ use sss_render::integrators::exact::Exact;
 use sss_render::integrators::pathtrace::PathTrace;
 use sss_render::irradiance::{self, IrradianceSettings};
 use sss_render::progress::NoProgress;
-use sss_render::scene::{Camera, Light, Material, MaterialKind, Mesh, Object, Scene, Translucent};
+use sss_render::scene::{Camera, Light, Scene};
 use sss_render::{RenderOutput, RenderSettings, render};
 use std::f64::consts::PI;
-
-/// A UV sphere of `rings` × `segments` quads, outward normals.
-fn uv_sphere(centre: DVec3, radius: f64, rings: u32, segments: u32) -> Mesh {
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    for i in 0..=rings {
-        let theta = PI * i as f64 / rings as f64;
-        for j in 0..segments {
-            let phi = 2.0 * PI * j as f64 / segments as f64;
-            let n = DVec3::new(
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                theta.sin() * phi.sin(),
-            );
-            positions.push(centre + n * radius);
-            normals.push(n);
-        }
-    }
-    let mut triangles = Vec::new();
-    let idx = |i: u32, j: u32| i * segments + (j % segments);
-    for i in 0..rings {
-        for j in 0..segments {
-            let (a, b, c, d) = (idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1));
-            // Counter-clockwise seen from outside.
-            if i != 0 {
-                triangles.push([a, b, c]);
-            }
-            if i + 1 != rings {
-                triangles.push([b, d, c]);
-            }
-        }
-    }
-    Mesh {
-        positions,
-        normals,
-        triangles,
-    }
-}
-
-/// A square in the plane y = 0 of side `size`, facing +y, split into n × n cells.
-fn square(size: f64, n: u32) -> Mesh {
-    let mut positions = Vec::new();
-    for i in 0..=n {
-        for j in 0..=n {
-            let x = -size / 2.0 + size * j as f64 / n as f64;
-            let z = -size / 2.0 + size * i as f64 / n as f64;
-            positions.push(DVec3::new(x, 0.0, z));
-        }
-    }
-    let normals = vec![DVec3::Y; positions.len()];
-    let mut triangles = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            let a = i * (n + 1) + j;
-            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
-            // (b - a) × (c - a) = x × z = -y, so order a, c, b for +y.
-            triangles.push([a, c, b]);
-            triangles.push([b, c, d]);
-        }
-    }
-    Mesh {
-        positions,
-        normals,
-        triangles,
-    }
-}
-
-fn translucent(model: ModelKind, preset: &str, units_per_mm: f64) -> Material {
-    Material {
-        name: preset.into(),
-        kind: MaterialKind::Translucent(Translucent {
-            model,
-            medium: Medium::preset(preset).unwrap(),
-            units_per_mm,
-            texture: None,
-        }),
-    }
-}
-
-fn scene_with(mesh: Mesh, material: Material, lights: Vec<Light>, camera: Camera) -> Scene {
-    Scene {
-        name: "test".into(),
-        path: None,
-        camera,
-        lights,
-        materials: vec![material],
-        objects: vec![Object {
-            name: "object".into(),
-            material: 0,
-            mesh,
-            curvature: None,
-        }],
-        warnings: Vec::new(),
-    }
-}
 
 /// A large flat slab under a distant light, seen from above: away from the edges the exact
 /// sum equals the closed form F_t(η, cos θ_o)/(cπ) · E_t · R_d,total (a semi-infinite

@@ -34,8 +34,8 @@
 pub use super::{PIXEL_LEAF, TASK_ITEMS, curvature_at_hits, pixel_footprint};
 
 use super::{
-    Counts, accepts, add_samples, eps_sweep, illumination_tree_bytes, illumination_trees, rd_times,
-    shading_points, tasks,
+    Counts, accepts, add_samples, eps_sweep, for_each_dual_object, illumination_tree_bytes,
+    illumination_trees, pixel_trees, rd_times, shading_points, task_slices,
 };
 use crate::Error;
 use crate::frame::Frame;
@@ -308,68 +308,45 @@ impl Integrator for DualTree {
         let samples = frame.irradiance_samples(&self.irradiance);
         let trees = frame.timed("illumination_tree", || illumination_trees(frame, &samples));
         let points = frame.timed("fourier", || shading_points(frame))?;
-        let pixel_trees: Vec<Option<PixelTree>> = frame.timed("shading_tree", || {
-            points
-                .iter()
-                .map(|p| p.as_ref().map(|(pts, _)| PixelTree::build(pts, PIXEL_LEAF)))
-                .collect()
-        });
+        let pixel_trees = pixel_trees(frame, &points);
         let counts = Counts::default();
         let pixels = frame.gbuffer.pixels();
         let mut rate_layer = vec![[0.0; 3]; pixels];
         let mut cluster_layer = vec![[0.0; 3]; pixels];
         let mut values = vec![[0.0; 3]; frame.gbuffer.samples.len()];
-        let mut shaded_points = 0u64;
-        frame.timed("shading", || {
-            for &o in &frame.visible {
-                let (Some(sh), Some(irr), Some(px), Some((pts, index))) = (
-                    frame.shading_of(o),
-                    trees[o as usize].as_ref(),
-                    pixel_trees[o as usize].as_ref(),
-                    points[o as usize].as_ref(),
-                ) else {
-                    continue;
-                };
-                let ordered: Vec<PixelPoint> =
-                    px.tree.order.iter().map(|&k| pts[k as usize]).collect();
-                shaded_points += ordered.len() as u64;
-                let mut acc = vec![[0.0; 3]; ordered.len()];
-                if !irr.tree.nodes.is_empty() {
+        let shaded_points = frame.timed("shading", || {
+            for_each_dual_object(frame, &trees, &pixel_trees, &points, |obj| {
+                let (sh, px) = (obj.sh, obj.px);
+                let mut acc = vec![[0.0; 3]; obj.ordered.len()];
+                if !obj.irr.tree.nodes.is_empty() {
                     let dual = Dual {
                         px,
-                        irr,
-                        points: &ordered,
+                        irr: obj.irr,
+                        points: &obj.ordered,
                         eps: self.eps,
                         rho: self.rho,
                         sh,
                     };
-                    // Disjoint slices of `acc`, one per task, in tree order.
-                    let roots = tasks(px);
-                    let mut slices = Vec::with_capacity(roots.len());
-                    let mut rest: &mut [Rgb] = &mut acc;
-                    for &s in &roots {
-                        let (a, b) = rest.split_at_mut(px.tree.nodes[s as usize].len());
-                        slices.push((s, a));
-                        rest = b;
-                    }
-                    slices.into_par_iter().for_each(|(s, slice)| {
-                        let mut l = Local::default();
-                        dual.dual(s, 0, slice, &mut l);
-                        counts.add(l.visits, l.clusters, l.samples);
-                        progress.advance(slice.len() as u64);
-                    });
+                    task_slices(px, &mut acc)
+                        .into_par_iter()
+                        .for_each(|(s, slice)| {
+                            let mut l = Local::default();
+                            dual.dual(s, 0, slice, &mut l);
+                            counts.add(l.visits, l.clusters, l.samples);
+                            progress.advance(slice.len() as u64);
+                        });
                 } else {
-                    progress.advance(ordered.len() as u64);
+                    progress.advance(obj.ordered.len() as u64);
                 }
                 let labels = cluster_labels(px, self.rho);
-                for (k, &item) in px.tree.order.iter().enumerate() {
-                    let gi = index[item as usize] as usize;
+                for (k, a) in acc.iter().enumerate() {
+                    let gi = obj.sample(k);
                     let g = &frame.gbuffer.samples[gi];
                     let mut v = [0.0; 3];
-                    add_scaled(&mut v, acc[k], sh.exit_weight(g.n, g.wo));
+                    add_scaled(&mut v, *a, sh.exit_weight(g.n, g.wo));
                     values[gi] = v;
                     let p = g.pixel as usize;
-                    let r = ordered[k].rate;
+                    let r = obj.ordered[k].rate;
                     if r > rate_layer[p][0] {
                         rate_layer[p] = [r; 3];
                     }
@@ -377,7 +354,7 @@ impl Integrator for DualTree {
                         cluster_layer[p] = label_colour(labels[k]);
                     }
                 }
-            }
+            })
         });
         // Progress counts every G-buffer sample once: the ones no tree shaded (opaque surfaces,
         // background objects) now.

@@ -103,7 +103,8 @@
 
 use super::{
     Counts, ObjectPoints, PIXEL_LEAF, TASK_ITEMS, accepts, add_samples, eps_sweep,
-    illumination_tree_bytes, illumination_trees, rd_times, shading_points, tasks,
+    for_each_dual_object, illumination_tree_bytes, illumination_trees, pixel_trees, rd_times,
+    shading_points, task_slices,
 };
 use crate::Error;
 use crate::frame::Frame;
@@ -752,35 +753,19 @@ impl Integrator for DualTreeFmm {
         } else {
             plain_points(frame)
         };
-        let pixel_trees: Vec<Option<PixelTree>> = frame.timed("shading_tree", || {
-            points
-                .iter()
-                .map(|p| p.as_ref().map(|(pts, _)| PixelTree::build(pts, PIXEL_LEAF)))
-                .collect()
-        });
+        let pixel_trees = pixel_trees(frame, &points);
         let counts = Counts::default();
         let sample_expansions = AtomicU64::new(0);
         let mut values = vec![[0.0; 3]; frame.gbuffer.samples.len()];
-        let mut shaded_points = 0u64;
-        frame.timed("shading", || {
-            for &o in &frame.visible {
-                let (Some(sh), Some(irr), Some(px), Some((pts, index))) = (
-                    frame.shading_of(o),
-                    trees[o as usize].as_ref(),
-                    pixel_trees[o as usize].as_ref(),
-                    points[o as usize].as_ref(),
-                ) else {
-                    continue;
-                };
-                let ordered: Vec<PixelPoint> =
-                    px.tree.order.iter().map(|&k| pts[k as usize]).collect();
-                shaded_points += ordered.len() as u64;
-                let mut acc = vec![[0.0; 3]; ordered.len()];
+        let shaded_points = frame.timed("shading", || {
+            for_each_dual_object(frame, &trees, &pixel_trees, &points, |obj| {
+                let (sh, px, irr) = (obj.sh, obj.px, obj.irr);
+                let mut acc = vec![[0.0; 3]; obj.ordered.len()];
                 if !irr.tree.nodes.is_empty() && !px.tree.nodes.is_empty() {
                     let fmm = Fmm {
                         px,
                         irr,
-                        points: &ordered,
+                        points: &obj.ordered,
                         sh,
                         eps: self.eps,
                         eps_px: self.px_ratio * self.eps,
@@ -801,45 +786,38 @@ impl Integrator for DualTreeFmm {
                             })
                             .collect(),
                     };
-                    // Disjoint slices of `acc`, one per task, in tree order.
-                    let roots = tasks(px);
-                    let mut slices = Vec::with_capacity(roots.len());
-                    let mut rest: &mut [Rgb] = &mut acc;
-                    for &s in &roots {
-                        let (a, b) = rest.split_at_mut(px.tree.nodes[s as usize].len());
-                        slices.push((s, a));
-                        rest = b;
-                    }
-                    slices.into_par_iter().for_each(|(s, slice)| {
-                        let mut t = Task {
-                            root: s,
-                            start: px.tree.nodes[s as usize].start as usize,
-                            acc: slice,
-                            local: vec![LocalExpansion::default(); subtree_nodes(px, s)],
-                            visits: 0,
-                            clusters: 0,
-                            samples: 0,
-                            sample_expansions: 0,
-                        };
-                        fmm.dual(s, 0, &mut t);
-                        fmm.push_down(&mut t);
-                        counts.add(t.visits, t.clusters, t.samples);
-                        sample_expansions.fetch_add(t.sample_expansions, Ordering::Relaxed);
-                        progress.advance(t.acc.len() as u64);
-                    });
+                    task_slices(px, &mut acc)
+                        .into_par_iter()
+                        .for_each(|(s, slice)| {
+                            let mut t = Task {
+                                root: s,
+                                start: px.tree.nodes[s as usize].start as usize,
+                                acc: slice,
+                                local: vec![LocalExpansion::default(); subtree_nodes(px, s)],
+                                visits: 0,
+                                clusters: 0,
+                                samples: 0,
+                                sample_expansions: 0,
+                            };
+                            fmm.dual(s, 0, &mut t);
+                            fmm.push_down(&mut t);
+                            counts.add(t.visits, t.clusters, t.samples);
+                            sample_expansions.fetch_add(t.sample_expansions, Ordering::Relaxed);
+                            progress.advance(t.acc.len() as u64);
+                        });
                 } else {
-                    progress.advance(ordered.len() as u64);
+                    progress.advance(obj.ordered.len() as u64);
                 }
-                for (k, &item) in px.tree.order.iter().enumerate() {
-                    let gi = index[item as usize] as usize;
+                for (k, a) in acc.iter().enumerate() {
+                    let gi = obj.sample(k);
                     let g = &frame.gbuffer.samples[gi];
                     // A truncated expansion may dip below 0 where the sum is near 0.
-                    let a = acc[k].map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
+                    let a = a.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
                     let mut v = [0.0; 3];
                     add_scaled(&mut v, a, sh.exit_weight(g.n, g.wo));
                     values[gi] = v;
                 }
-            }
+            })
         });
         progress.advance(frame.gbuffer.samples.len() as u64 - shaded_points);
         let mut stats = counts.stats("node_pairs_visited");

@@ -4,7 +4,8 @@
 //! al. 2019 Algorithm 2; `dual_tree_fmm`, local expansions). This module holds what they share:
 //! the illumination tree over irradiance samples and its traversal primitives, the work
 //! counters, the ε sweep, and the dual trees' shading points with their s_p (Milaenen et al.
-//! Eq. 4-5) and parallel task split. Every method here is radial-only except `exact`.
+//! Eq. 4-5), their pixel trees, the loop over the objects they shade and the parallel task
+//! split. Every method here is radial-only except `exact`.
 
 pub mod dual_tree;
 pub mod dual_tree_fmm;
@@ -296,6 +297,85 @@ pub(crate) fn shading_points(frame: &Frame<'_>) -> Result<ObjectPoints, Error> {
         out[o as usize] = Some((points, index));
     }
     Ok(out)
+}
+
+/// One pixel tree over each object's shading points, timed as the `shading_tree` stage.
+pub(crate) fn pixel_trees(frame: &Frame<'_>, points: &ObjectPoints) -> Vec<Option<PixelTree>> {
+    frame.timed("shading_tree", || {
+        points
+            .iter()
+            .map(|p| p.as_ref().map(|(pts, _)| PixelTree::build(pts, PIXEL_LEAF)))
+            .collect()
+    })
+}
+
+/// One visible translucent object as the dual trees shade it: its shading, its two trees, and
+/// its shading points in pixel-tree order.
+pub(crate) struct DualObject<'a> {
+    /// The object's material shading.
+    pub(crate) sh: &'a TranslucentShading,
+    /// The illumination tree over its irradiance samples.
+    pub(crate) irr: &'a IrradianceTree,
+    /// The pixel tree over its shading points.
+    pub(crate) px: &'a PixelTree,
+    /// The shading points in pixel-tree order.
+    pub(crate) ordered: Vec<PixelPoint>,
+    /// The G-buffer sample of each shading point, in the points' order before the tree.
+    index: &'a [u32],
+}
+
+impl DualObject<'_> {
+    /// The G-buffer sample of the `k`-th shading point in tree order.
+    pub(crate) fn sample(&self, k: usize) -> usize {
+        self.index[self.px.tree.order[k] as usize] as usize
+    }
+}
+
+/// Calls `shade` for every visible translucent object that has its trees and shading points,
+/// in `frame.visible`'s order, and returns how many shading points they hold (the G-buffer
+/// samples the dual trees shade, for progress).
+pub(crate) fn for_each_dual_object(
+    frame: &Frame<'_>,
+    trees: &[Option<IrradianceTree>],
+    pixel_trees: &[Option<PixelTree>],
+    points: &ObjectPoints,
+    mut shade: impl FnMut(DualObject<'_>),
+) -> u64 {
+    let mut shaded = 0u64;
+    for &o in &frame.visible {
+        let (Some(sh), Some(irr), Some(px), Some((pts, index))) = (
+            frame.shading_of(o),
+            trees[o as usize].as_ref(),
+            pixel_trees[o as usize].as_ref(),
+            points[o as usize].as_ref(),
+        ) else {
+            continue;
+        };
+        let ordered: Vec<PixelPoint> = px.tree.order.iter().map(|&k| pts[k as usize]).collect();
+        shaded += ordered.len() as u64;
+        shade(DualObject {
+            sh,
+            irr,
+            px,
+            ordered,
+            index,
+        });
+    }
+    shaded
+}
+
+/// `acc` (one value per shading point, in pixel-tree order) cut into the disjoint slices of
+/// the task roots ([`tasks`]), each with its root, so the tasks can run in parallel.
+pub(crate) fn task_slices<'a>(px: &PixelTree, acc: &'a mut [Rgb]) -> Vec<(u32, &'a mut [Rgb])> {
+    let roots = tasks(px);
+    let mut slices = Vec::with_capacity(roots.len());
+    let mut rest = acc;
+    for &s in &roots {
+        let (a, b) = rest.split_at_mut(px.tree.nodes[s as usize].len());
+        slices.push((s, a));
+        rest = b;
+    }
+    slices
 }
 
 /// The task roots: pixel-tree nodes with at most [`TASK_ITEMS`] points whose parent has more

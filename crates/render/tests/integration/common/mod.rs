@@ -5,11 +5,16 @@
 
 pub mod rasterizer;
 
+use glam::DVec3;
+use sss_bssrdf::{Medium, ModelKind};
 use sss_render::frame::Frame;
 use sss_render::integrators::{Integrator, MethodOptions, Shaded};
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::progress::NoProgress;
-use sss_render::scene::{LoadOptions, Scene, builtin};
+use sss_render::scene::{
+    Camera, Light, LoadOptions, Material, MaterialKind, Mesh, Object, Scene, Translucent, builtin,
+};
+use std::f64::consts::PI;
 
 /// Cheap options per registered method, for tests that run every method on a small frame and
 /// check properties that do not depend on accuracy (finite values, exact zeros, coverage,
@@ -46,4 +51,126 @@ pub fn irradiance(spacing: f64) -> IrradianceSettings {
 /// `m` on `frame`, without progress.
 pub fn run(frame: &Frame<'_>, m: &dyn Integrator) -> Shaded {
     m.integrate(frame, &NoProgress).unwrap()
+}
+
+/// A UV sphere about `centre` of `rings` × `segments` quads, outward normals.
+pub fn uv_sphere(centre: DVec3, radius: f64, rings: u32, segments: u32) -> Mesh {
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    for i in 0..=rings {
+        let theta = PI * i as f64 / rings as f64;
+        for j in 0..segments {
+            let phi = 2.0 * PI * j as f64 / segments as f64;
+            let n = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            positions.push(centre + n * radius);
+            normals.push(n);
+        }
+    }
+    let mut triangles = Vec::new();
+    let idx = |i: u32, j: u32| i * segments + (j % segments);
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1));
+            // Counter-clockwise seen from outside.
+            if i != 0 {
+                triangles.push([a, b, c]);
+            }
+            if i + 1 != rings {
+                triangles.push([b, d, c]);
+            }
+        }
+    }
+    Mesh {
+        positions,
+        normals,
+        triangles,
+    }
+}
+
+/// A square in the plane y = 0 of side `size`, facing +y, split into n × n cells.
+pub fn square(size: f64, n: u32) -> Mesh {
+    let mut positions = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let x = -size / 2.0 + size * j as f64 / n as f64;
+            let z = -size / 2.0 + size * i as f64 / n as f64;
+            positions.push(DVec3::new(x, 0.0, z));
+        }
+    }
+    let normals = vec![DVec3::Y; positions.len()];
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let a = i * (n + 1) + j;
+            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
+            // (b - a) × (c - a) = x × z = -y, so order a, c, b for +y.
+            triangles.push([a, c, b]);
+            triangles.push([b, c, d]);
+        }
+    }
+    Mesh {
+        positions,
+        normals,
+        triangles,
+    }
+}
+
+/// A translucent material of `preset` with `model`, at `units_per_mm` scene units per mm.
+pub fn translucent(model: ModelKind, preset: &str, units_per_mm: f64) -> Material {
+    Material {
+        name: preset.into(),
+        kind: MaterialKind::Translucent(Translucent {
+            model,
+            medium: Medium::preset(preset).unwrap(),
+            units_per_mm,
+            texture: None,
+        }),
+    }
+}
+
+/// A scene of one object, `mesh` in `material`, under `lights`, seen by `camera`.
+pub fn scene_with(mesh: Mesh, material: Material, lights: Vec<Light>, camera: Camera) -> Scene {
+    scene_of(vec![mesh], material, lights, camera)
+}
+
+/// A scene of one object per mesh, all in `material`, under `lights`, seen by `camera`.
+pub fn scene_of(
+    meshes: Vec<Mesh>,
+    material: Material,
+    lights: Vec<Light>,
+    camera: Camera,
+) -> Scene {
+    Scene {
+        name: "test".into(),
+        path: None,
+        camera,
+        lights,
+        materials: vec![material],
+        objects: meshes
+            .into_iter()
+            .enumerate()
+            .map(|(i, mesh)| Object {
+                name: format!("object{i}"),
+                material: 0,
+                mesh,
+                curvature: None,
+            })
+            .collect(),
+        warnings: Vec::new(),
+    }
+}
+
+/// A grey diffuse material (albedo 0.5).
+pub fn diffuse() -> Material {
+    Material {
+        name: "grey".into(),
+        kind: MaterialKind::Diffuse {
+            albedo: [0.5; 3],
+            texture: None,
+        },
+    }
 }

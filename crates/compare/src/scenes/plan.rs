@@ -1,0 +1,124 @@
+//! What the scenes experiment runs: its units (a method at one value of its sweep on one
+//! scene), the plan of a run, and the facts of each scene the report needs.
+
+use super::*;
+
+/// One unit of the sweep: a method (index into `METHODS`) at one value of its sweep (index)
+/// on one scene (index into the plan's scenes), with all threads, and with one thread too at
+/// the middle of the sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct SweepUnit {
+    pub scene: usize,
+    pub method: usize,
+    pub value: usize,
+}
+
+impl SweepUnit {
+    /// Every unit of `scenes` scenes, in report order: scene, then method, then sweep value.
+    pub fn all(scenes: usize, quick: bool) -> Vec<SweepUnit> {
+        let mut units = Vec::new();
+        for scene in 0..scenes {
+            for (method, m) in METHODS.iter().enumerate() {
+                for value in 0..(m.sweep.values)(quick).len() {
+                    units.push(SweepUnit {
+                        scene,
+                        method,
+                        value,
+                    });
+                }
+            }
+        }
+        units
+    }
+
+    /// Whether the unit has a one-thread run too: only the middle of each sweep, since the
+    /// speed-up and the same-bits check need one point per method, and one-thread runs of
+    /// every point would double the main job's time.
+    pub fn with_one_thread(&self, quick: bool) -> bool {
+        self.value == (METHODS[self.method].sweep.values)(quick).len() / 2
+    }
+}
+
+/// The sweep: the scenes loaded (in order, with their TOML text), the ones skipped (a missing
+/// mesh), and every unit.
+pub(crate) struct ScenePlan {
+    pub scenes: Vec<(Scene, String)>,
+    pub skipped: Vec<String>,
+    pub units: Vec<SweepUnit>,
+}
+
+/// What the report needs of a plan, without the scenes themselves: what a shard records and a
+/// merge reads back.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct PlanOutline {
+    /// Scene names, in order.
+    pub scenes: Vec<String>,
+    /// Skip messages of scenes that were not loaded.
+    pub skipped: Vec<String>,
+    /// Every unit.
+    pub units: Vec<SweepUnit>,
+}
+
+impl ScenePlan {
+    /// The plan without its scenes.
+    pub fn outline(&self) -> PlanOutline {
+        PlanOutline {
+            scenes: self.scenes.iter().map(|(s, _)| s.name.clone()).collect(),
+            skipped: self.skipped.clone(),
+            units: self.units.clone(),
+        }
+    }
+}
+
+/// Loads the run's scenes and lists the units of the sweep.
+pub(crate) fn plan(ctx: &Context<'_>) -> Result<ScenePlan, Error> {
+    let (scenes, skipped) = load_scenes(ctx, &ctx.config.scenes)?;
+    let units = SweepUnit::all(scenes.len(), ctx.config.quick);
+    Ok(ScenePlan {
+        scenes,
+        skipped,
+        units,
+    })
+}
+
+/// What the report says of a scene: its size, the reference's pixels, samples and time.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct SceneInfo {
+    pub width: u32,
+    pub height: u32,
+    /// Pixels covered by translucent objects (where errors are measured).
+    pub pixels: usize,
+    /// Irradiance samples of the reference.
+    pub samples: usize,
+    /// Seconds the reference took (when it was rendered, maybe in an earlier run).
+    pub seconds: f64,
+    /// Threads of the run that reports it.
+    pub threads: usize,
+}
+
+impl SceneInfo {
+    /// The info as one tab-separated line (see [`SceneInfo::from_record`]).
+    pub fn record(&self) -> String {
+        format!(
+            "{}\t{}\t{}\t{}\t{:e}\t{}",
+            self.width, self.height, self.pixels, self.samples, self.seconds, self.threads
+        )
+    }
+
+    /// Parses a line of [`SceneInfo::record`].
+    pub fn from_record(line: &str) -> Result<SceneInfo, String> {
+        let f: Vec<&str> = line.split('\t').collect();
+        if f.len() != 6 {
+            return Err(format!("{} fields, 6 expected", f.len()));
+        }
+        let bad = |i: usize| format!("field {}: `{}` is not a number", i + 1, f[i]);
+        Ok(SceneInfo {
+            width: f[0].parse().map_err(|_| bad(0))?,
+            height: f[1].parse().map_err(|_| bad(1))?,
+            pixels: f[2].parse().map_err(|_| bad(2))?,
+            samples: f[3].parse().map_err(|_| bad(3))?,
+            seconds: f[4].parse().map_err(|_| bad(4))?,
+            threads: f[5].parse().map_err(|_| bad(5))?,
+        })
+    }
+}
