@@ -235,11 +235,11 @@ impl PbdTable {
 /// Photon beam diffusion for one [`Medium`], backed by the shared [`PbdTable`] of its (g, η)
 /// (pbrt 3rd ed. `TabulatedBSSRDF` with the table of `ComputeBeamDiffusionBSSRDF`).
 ///
-/// - [`Bssrdf::rd`](crate::Bssrdf::rd) is σ_t² times the table spline at (ρ, r σ_t) divided by 2π r σ_t
+/// - [`Bssrdf::rd`] is σ_t² times the table spline at (ρ, r σ_t) divided by 2π r σ_t
 ///   (pbrt Eq. 11.10), clamped to ≥ 0, and 0 beyond the table's ≈ 204 mean free paths.
-/// - [`Bssrdf::total_diffuse_reflectance`](crate::Bssrdf::total_diffuse_reflectance) is the interpolated effective albedo.
-/// - [`Bssrdf::sample_sr`](crate::Bssrdf::sample_sr) inverts the CDF of the interpolated spline (the algorithm of
-///   [`crate::catmull_rom::sample_catmull_rom_2d`]) and [`Bssrdf::pdf_sr`](crate::Bssrdf::pdf_sr) is its exact
+/// - [`Bssrdf::total_diffuse_reflectance`] is the interpolated effective albedo.
+/// - [`Bssrdf::sample_sr`] inverts the CDF of the interpolated spline (the algorithm of
+///   [`crate::catmull_rom::sample_catmull_rom_2d`]) and [`Bssrdf::pdf_sr`] is its exact
 ///   density per unit radius, spline · σ_t / ∫spline (pbrt's `Pdf_Sr` is the per-area
 ///   density; ours is multiplied by 2πr). Where the spline dips below 0 between two knots
 ///   (the far tail at albedo → 1 for g = 0.9, up to 1.5·10⁻⁴ of the mass) pbrt's pair is
@@ -252,6 +252,11 @@ impl PbdTable {
 ///   rounding, evaluated with a constant-time knot lookup.
 /// - When the interpolated ρ_eff is not positive (albedo 0) both fall back to the
 ///   exponential distribution σ_t e^{−σ_t r}.
+///
+/// [`Bssrdf::rd`]: crate::Bssrdf::rd
+/// [`Bssrdf::total_diffuse_reflectance`]: crate::Bssrdf::total_diffuse_reflectance
+/// [`Bssrdf::sample_sr`]: crate::Bssrdf::sample_sr
+/// [`Bssrdf::pdf_sr`]: crate::Bssrdf::pdf_sr
 #[derive(Clone, Debug)]
 pub struct PhotonBeamDiffusion {
     medium: Medium,

@@ -64,15 +64,15 @@
 //! # The far tail: a fitted diffusion far field
 //! Measured against MCML (Wang, Jacques & Zheng, *MCML — Monte Carlo modeling of light
 //! transport in multi-layered tissues*, Comput. Methods Programs Biomed. 47, 1995; 12 media
-//! of reduced albedo 0.68–0.9999, `tests/integration/mcml.rs`, its `stages` test prints the figures) on
-//! the table's own bins, the tallies, the pooling, the isotonic fit, the histopolation and
-//! the albedo blend all agree with MCML within the tallies' noise up to ≈ 10 mean free paths
-//! (worst −4.3 % at 8 mean free paths for ketchup, 2.6 of the tallies' standard errors);
-//! what departed was the tail beyond: bins were kept as tallied up to a relative standard
-//! error of 20 % ([`RESOLVED_REL_SE`]), so at albedos 0.65–0.85 the rows carried their
-//! tallies' noise, 5–20 % per bin at 10–16 mean free paths (ketchup +38 % at 14 mean free
-//! paths, skin1 −24 % at 15.5), and the spline through them up to 3 times MCML's value in
-//! single MCML bins. (Deviations of single MCML bins closer in, quoted at 5–35 %, were
+//! of reduced albedo 0.68–0.9999, `tests/integration/mcml.rs`, whose `stages` test prints
+//! the figures) on the table's own bins, the tallies, the pooling, the isotonic fit, the
+//! histopolation and the albedo blend all agree with MCML within the tallies' noise up to ≈ 10
+//! mean free paths (worst −4.3 % at 8 mean free paths for ketchup, 2.6 of the tallies'
+//! standard errors); what departed was the tail beyond: bins were kept as tallied up to a
+//! relative standard error of 20 % ([`RESOLVED_REL_SE`]), so at albedos 0.65–0.85 the rows
+//! carried their tallies' noise, 5–20 % per bin at 10–16 mean free paths (ketchup +38 % at
+//! 14 mean free paths, skin1 −24 % at 15.5), and the spline through them up to 3 times MCML's
+//! value in single MCML bins. (Deviations of single MCML bins closer in, quoted at 5–35 %, were
 //! MCML's own noise — its bins have heavy-tailed errors estimated from 5 batches — and at
 //! η = 1.3 its normalisation per incident rather than per entering photon, 1.7 %.)
 //!
@@ -87,8 +87,8 @@
 //! and σ_tr = 0.87; Case & Zweifel, *Linear Transport Theory*, 1967, §4). Its bin integrals
 //! are closed-form. The replaced bins keep their tallied light, so every row's total is
 //! unchanged. After it, every MCML case is within 3 % + 3 standard errors up to
-//! 10 mean free paths and 10 % + 3 standard errors up to 16 (see `tests/integration/mcml.rs` for the
-//! margins and how MCML's noise is treated); evaluation is unchanged, and building a table
+//! 10 mean free paths and 10 % + 3 standard errors up to 16 (see `tests/integration/mcml.rs`
+//! for the margins and how MCML's noise is treated); evaluation is unchanged, and building a table
 //! costs one small fit per row.
 //!
 //! # Generation

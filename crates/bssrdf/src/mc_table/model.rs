@@ -12,16 +12,21 @@ use std::sync::Arc;
 /// [`McTable`] of its η and g, scaled to its reduced extinction.
 ///
 /// - With σ'_t = σ_a + σ_s(1 − g) and ρ' = σ_s(1 − g)/σ'_t (the tables' reduced units, see
-///   the module documentation), [`Bssrdf::rd`](crate::Bssrdf::rd) is σ'_t² times the table row blended at ρ',
+///   the module documentation), [`Bssrdf::rd`] is σ'_t² times the table row blended at ρ',
 ///   evaluated at x = rσ'_t and divided by 2πx, clamped to ≥ 0, and 0 beyond the table's
 ///   last knot. The row's first interval [0, 0.0005] is linear in 2πx R_d
 ///   ([`SplineRow::with_linear_first_segment`]): R_d is constant there instead of bumping.
-/// - [`Bssrdf::total_diffuse_reflectance`](crate::Bssrdf::total_diffuse_reflectance) is the row's integral (the interpolated effective
+/// - [`Bssrdf::total_diffuse_reflectance`] is the row's integral (the interpolated effective
 ///   albedo up to that first interval, ≈ 10⁻⁵ of it), clamped to [0, 1].
-/// - [`Bssrdf::sample_sr`](crate::Bssrdf::sample_sr) inverts the CDF of the non-negative row
-///   ([`SplineRow::non_negative`]) and [`Bssrdf::pdf_sr`](crate::Bssrdf::pdf_sr) is its exact density, as for
+/// - [`Bssrdf::sample_sr`] inverts the CDF of the non-negative row
+///   ([`SplineRow::non_negative`]) and [`Bssrdf::pdf_sr`] is its exact density, as for
 ///   [`crate::PhotonBeamDiffusion`]; a channel without tabulated mass (ρ' = 0) samples
 ///   σ'_t e^{−σ'_t r}.
+///
+/// [`Bssrdf::rd`]: crate::Bssrdf::rd
+/// [`Bssrdf::total_diffuse_reflectance`]: crate::Bssrdf::total_diffuse_reflectance
+/// [`Bssrdf::sample_sr`]: crate::Bssrdf::sample_sr
+/// [`Bssrdf::pdf_sr`]: crate::Bssrdf::pdf_sr
 #[derive(Clone, Debug)]
 pub struct McTableModel {
     medium: Medium,

@@ -1,11 +1,11 @@
 //! Experiment "profiles": every radial-profile method against the Monte Carlo reference.
 //!
 //! For each preset and channel, each registered [`ProfileMethod`] is built, its area averages
-//! over the reference's bins are compared with the Monte Carlo bins ([`super::metrics`]), its
+//! over the reference's bins are compared with the Monte Carlo bins ([`metrics`]), its
 //! total diffuse reflectance with the Monte Carlo total, and its evaluation cost is timed.
 //! Writes `profiles.csv`, `profile_<preset>.png`, `error_<preset>.png` and
 //! `error_vs_cost.png`, and returns the report section. Where the shared MCML profiles exist
-//! ([`super::mcml`]), every model is also compared with MCML, an independent Monte Carlo code
+//! ([`mcml`]), every model is also compared with MCML, an independent Monte Carlo code
 //! (Wang, Jacques & Zheng 1995), in a subsection of its own and `mcml.csv`.
 //!
 //! To add a method (e.g. a fitted kernel from a later crate), implement [`ProfileMethod`] and

@@ -1,17 +1,18 @@
 //! The rendering experiment: every registered method (`sss_render::integrators::METHODS`) over
-//! its compare sweep on the
-//! default scenes (and any named ones), against a cached `exact` reference per scene.
-//! Files: [`plan`] (the sweep as units), [`load`] (scenes), [`cache`] (references), [`runs`]
-//! (timed runs, `results.csv`, records), [`images`] (pictures), [`report`] (`results.csv`, the
-//! plots and the report section from the units' results, [`assemble`]); this one runs a list
-//! of units ([`run_units`]). An unsharded run plans, runs and assembles in one process;
-//! `--shard` runs a share of the units and `--merge` assembles the shards' results (see
-//! `super::shard`).
+//! its compare sweep on the default scenes (and any named ones), against a cached `exact`
+//! reference per scene.
 //!
-//! Writes `results.csv` (one row per run and thread count; columns documented in `docs/compare.md`),
-//! `error_vs_time_<scene>.png` (log-log RMSE against total seconds), and under
-//! `scenes/<scene>/` the reference, each method's most expensive render and its false-colour
-//! error map.
+//! Files: [`plan`](mod@plan) (the sweep as units), [`load`] (scenes), [`cache`] (references),
+//! [`runs`] (timed runs, `results.csv`, records), [`images`] (pictures), [`report`]
+//! (`results.csv`, the plots and the report section from the units' results, [`assemble`]);
+//! this one runs a list of units ([`run_units`]). An unsharded run plans, runs and assembles
+//! in one process; `--shard` runs a share of the units and `--merge` assembles the shards'
+//! results (see `super::shard`).
+//!
+//! Writes `results.csv` (one row per run and thread count; columns documented in
+//! `docs/compare.md`), `error_vs_time_<scene>.png` (log-log RMSE against total seconds), and
+//! under `scenes/<scene>/` the reference, each method's most expensive render and its
+//! false-colour error map.
 
 mod cache;
 mod images;

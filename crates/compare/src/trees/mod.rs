@@ -13,9 +13,10 @@
 //!    equal time.
 //!
 //! Error is measured against `exact` (the point sum both trees approximate, over the same
-//! irradiance samples) on a seeded uniform random subset of [`super::subset::SUBSET_PIXELS`] translucent pixels:
-//! the subset's mean squared error is an unbiased estimate of the whole image's, reported with
-//! its standard error (finite-population corrected). The subset reference is cached like the
+//! irradiance samples) on a seeded uniform random subset of
+//! [`super::subset::SUBSET_PIXELS`] translucent pixels: the subset's mean squared error is an
+//! unbiased estimate of the whole image's, reported with its standard error
+//! (finite-population corrected). The subset reference is cached like the
 //! scene references.
 //!
 //! Writes `trees.csv`, `trees_error_vs_time.png`, `trees_scaling.png` and `trees/*.png`

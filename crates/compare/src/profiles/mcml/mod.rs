@@ -7,7 +7,8 @@
 //! (`<workspace>/../shared/reference/mcml`, or `SSS_MCML_DIR`) holds per case the medium, the
 //! radial bin width, MCML's total diffuse reflectance with its standard error (`cases.csv`)
 //! and Rd_r per radial bin, the bin's area average, with its standard error (`<case>.csv`).
-//! The comparison follows `crates/bssrdf/tests/integration/mcml.rs`, which holds `mc-table` to it:
+//! The comparison follows `crates/bssrdf/tests/integration/mcml.rs`, which holds `mc-table`
+//! to it:
 //!
 //! - MCML counts its photons before the specular reflection at the boundary,
 //!   R_sp = ((η − 1)/(η + 1))² (Wang, Jacques & Zheng 1995, Eq. 3.1), while the models' R_d is
@@ -58,8 +59,8 @@ pub const NEAR: (f64, f64) = (0.25, 10.0);
 pub const FAR_END: f64 = 16.0;
 /// MCML standard errors a model may differ by before its difference counts.
 pub const SE_ALLOWANCE: f64 = 3.0;
-/// The margins of `crates/bssrdf/tests/integration/mcml.rs` for the near and far ranges; a bin beyond its
-/// margin alone but within it over its 5 bins is counted as *forgiven*.
+/// The margins of `crates/bssrdf/tests/integration/mcml.rs` for the near and far ranges; a bin
+/// beyond its margin alone but within it over its 5 bins is counted as *forgiven*.
 pub const MARGINS: (f64, f64) = (0.03, 0.10);
 /// Bins on each side of a bin in the forgiving rule's neighbourhood (5 bins in all).
 const NEIGHBOURS: usize = 2;

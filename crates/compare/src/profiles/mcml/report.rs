@@ -115,7 +115,8 @@ pub(super) fn report(
          MCML's profile and total are divided by 1 − R_sp. A model's value for a bin is its \
          area average over the MCML annulus ({GAUSS_POINTS}-point Gauss–Legendre of 2πr R_d). \
          MCML's standard error per bin comes from 5 batches; as in \
-         `crates/bssrdf/tests/integration/mcml.rs` it is pooled over the 21 bins around each bin.\n\n\
+         `crates/bssrdf/tests/integration/mcml.rs` it is pooled over the 21 bins around each \
+         bin.\n\n\
          - *excess*: (|model − MCML| − 3 SE)/MCML, worst over the bins of the range (0 when \
          every bin is within 3 SE), in reduced mean free paths x = r/ℓ, ℓ = 1/(σ_a + σ_s(1 − g)). \
          Single MCML bins have heavy-tailed errors (a few photons of large weight), so a bin \
