@@ -168,11 +168,6 @@ impl PlainBlur {
             .enumerate()
             .for_each(|(y, row)| {
                 #[cfg(target_arch = "x86_64")]
-                if wide_build() {
-                    // SAFETY: the CPU has AVX-512F, AVX2 and FMA (`wide_build`).
-                    return unsafe { fast::plain_h_wide(self, src, row, y, w) };
-                }
-                #[cfg(target_arch = "x86_64")]
                 if fast_build() {
                     // SAFETY: the CPU has AVX2 and FMA (`fast_build`).
                     return unsafe { fast::plain_h(self, src, row, y, w) };
@@ -184,11 +179,6 @@ impl PlainBlur {
             .par_chunks_mut(3 * w)
             .enumerate()
             .for_each(|(y, row)| {
-                #[cfg(target_arch = "x86_64")]
-                if wide_build() {
-                    // SAFETY: the CPU has AVX-512F, AVX2 and FMA (`wide_build`).
-                    return unsafe { fast::plain_v_wide(self, tmp, row, y, (w, h)) };
-                }
                 #[cfg(target_arch = "x86_64")]
                 if fast_build() {
                     // SAFETY: the CPU has AVX2 and FMA (`fast_build`).
@@ -206,46 +196,12 @@ fn fast_build() -> bool {
     std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
 }
 
-/// Whether the CPU also has AVX-512F: the floors then run rows compiled for it, as the pass
-/// under test runs its AVX-512 groups there.
-#[cfg(target_arch = "x86_64")]
-fn wide_build() -> bool {
-    fast_build() && std::arch::is_x86_feature_detected!("avx512f")
-}
-
 /// The floors' rows compiled for AVX2 and FMA (the row functions are inlined into these; a
 /// closure passed to a `target_feature` function is not reliably inlined, and then runs in
 /// the baseline build).
 #[cfg(target_arch = "x86_64")]
 mod fast {
     use super::{Frame, PlainBlur, VarBlur};
-
-    #[target_feature(enable = "avx512f,avx2,fma")]
-    pub fn plain_h_wide(b: &PlainBlur, src: &[f32], out: &mut [f32], y: usize, w: usize) {
-        b.row_h(src, out, y, w)
-    }
-
-    #[target_feature(enable = "avx512f,avx2,fma")]
-    pub fn plain_v_wide(
-        b: &PlainBlur,
-        src: &[f32],
-        out: &mut [f32],
-        y: usize,
-        (w, h): (usize, usize),
-    ) {
-        b.row_v(src, out, y, w, h)
-    }
-
-    #[target_feature(enable = "avx512f,avx2,fma")]
-    pub fn var_row_wide<const VERTICAL: bool>(
-        b: &VarBlur,
-        f: &Frame,
-        src: &[f32],
-        out: &mut [f32],
-        y: usize,
-    ) {
-        b.row::<VERTICAL>(f, src, out, y)
-    }
 
     #[target_feature(enable = "avx2,fma")]
     pub fn plain_h(b: &PlainBlur, src: &[f32], out: &mut [f32], y: usize, w: usize) {
@@ -395,11 +351,6 @@ impl VarBlur {
 
     /// [`VarBlur::row`] in the AVX2 + FMA build where the CPU has it.
     fn dispatch<const VERTICAL: bool>(&self, f: &Frame, src: &[f32], out: &mut [f32], y: usize) {
-        #[cfg(target_arch = "x86_64")]
-        if wide_build() {
-            // SAFETY: the CPU has AVX-512F, AVX2 and FMA (`wide_build`).
-            return unsafe { fast::var_row_wide::<VERTICAL>(self, f, src, out, y) };
-        }
         #[cfg(target_arch = "x86_64")]
         if fast_build() {
             // SAFETY: the CPU has AVX2 and FMA (`fast_build`).

@@ -53,6 +53,23 @@ pub fn write_entry(entry: &Path, bytes: &[u8]) -> Result<(), Error> {
     write_atomic(&sum_path(entry), sum_text(bytes).as_bytes())
 }
 
+/// What a cache reader returned (`Ok(None)`: no entry) as the entry to use: a corrupt entry
+/// is reported through `log` as `{subject}: cached {what} is corrupt (…), recomputing` and
+/// treated as absent, so every cache says the same thing when it recomputes.
+pub fn usable<T>(
+    read: Result<Option<T>, String>,
+    subject: &str,
+    what: &str,
+    log: &dyn Fn(&str),
+) -> Option<T> {
+    read.unwrap_or_else(|reason| {
+        log(&format!(
+            "{subject}: cached {what} is corrupt ({reason}), recomputing"
+        ));
+        None
+    })
+}
+
 /// What a cache look-up found.
 #[derive(Debug, PartialEq)]
 pub enum Entry {
@@ -106,6 +123,24 @@ pub fn check(entry: &Path) -> Entry {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+
+    #[test]
+    fn a_corrupt_entry_is_reported_and_recomputed() {
+        let lines = std::cell::RefCell::new(Vec::new());
+        let log = |l: &str| lines.borrow_mut().push(l.to_string());
+        assert_eq!(usable(Ok(Some(7)), "scene s", "reference", &log), Some(7));
+        assert_eq!(usable::<i32>(Ok(None), "scene s", "reference", &log), None);
+        assert!(
+            lines.borrow().is_empty(),
+            "a usable or absent entry logs nothing"
+        );
+        let bad = Err("length 3, sum says 4".to_string());
+        assert_eq!(usable::<i32>(bad, "scene s", "reference", &log), None);
+        assert_eq!(
+            *lines.borrow(),
+            ["scene s: cached reference is corrupt (length 3, sum says 4), recomputing"]
+        );
+    }
 
     /// A fresh scratch directory for a test.
     pub(in super::super) fn scratch(name: &str) -> PathBuf {

@@ -276,13 +276,9 @@ pub fn load_or_compute(
             let cached = if config.fresh {
                 None
             } else {
-                load_cached(&path, &key, &cfg).unwrap_or_else(|reason| {
-                    log(&format!(
-                        "{} {}: cached Monte Carlo reference is corrupt ({reason}), recomputing",
-                        preset.name, channel_name
-                    ));
-                    None
-                })
+                let subject = format!("{} {}", preset.name, channel_name);
+                let read = load_cached(&path, &key, &cfg);
+                checked::usable(read, &subject, "Monte Carlo reference", log)
             };
             let reference = match cached {
                 Some(r) => {

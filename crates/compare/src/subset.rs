@@ -81,19 +81,11 @@ pub fn subset_reference(
     let path = dir.join(format!("subset_{}_{key:016x}.txt", scene.name));
     let image_pixels = scene.camera.width as usize * scene.camera.height as usize;
     if !cfg.fresh {
-        match load(&path, image_pixels) {
-            Ok(Some(r)) => {
-                (ctx.log)(&format!(
-                    "scene {}: subset reference from cache",
-                    scene.name
-                ));
-                return Ok(r);
-            }
-            Ok(None) => {}
-            Err(reason) => (ctx.log)(&format!(
-                "scene {}: cached subset reference is corrupt ({reason}), recomputing",
-                scene.name
-            )),
+        let subject = format!("scene {}", scene.name);
+        let read = load(&path, image_pixels);
+        if let Some(r) = checked::usable(read, &subject, "subset reference", ctx.log) {
+            (ctx.log)(&format!("{subject}: subset reference from cache"));
+            return Ok(r);
         }
     }
     (ctx.log)(&format!(

@@ -62,6 +62,26 @@ impl ProbeRadii {
     }
 }
 
+/// The probe radii of every material in `shading` (a frame's, indexed by material; `None`
+/// for the opaque ones) whose spheres hold `energy` of each channel's profile, and the
+/// largest energy fraction they never sample ([`ProbeRadii::missed`], over the materials and
+/// channels; 0 when there is none).
+pub fn probe_radii(
+    shading: &[Option<TranslucentShading>],
+    energy: f64,
+) -> (Vec<Option<ProbeRadii>>, f64) {
+    let radii: Vec<Option<ProbeRadii>> = shading
+        .iter()
+        .map(|s| s.as_ref().map(|s| ProbeRadii::new(s, energy)))
+        .collect();
+    let missed = radii
+        .iter()
+        .flatten()
+        .flat_map(|r| r.missed)
+        .fold(0.0, f64::max);
+    (radii, missed)
+}
+
 /// The fraction of channel `ch`'s energy beyond radius `r_mm`: 1 − F with F the largest energy
 /// fraction whose radius ([`Bssrdf::radius_for_energy`](sss_bssrdf::Bssrdf::radius_for_energy),
 /// non-decreasing in F) is at most `r_mm`, found by bisection on F (60 halvings: F to ~1e-18,

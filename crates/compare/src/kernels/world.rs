@@ -2,14 +2,14 @@
 //! `exact` references the scenes experiment caches.
 
 use super::*;
+use crate::scenes::{load_scenes, reference};
+use sss_render::integrators::separable::Separable;
+use sss_render::metrics::error_figures;
+use sss_render::progress::NoProgress;
+use sss_render::{RenderSettings, render};
 
 /// Every kernel on the `sphere` and `slab` scenes against their cached `exact` references.
 pub(super) fn world_space(ctx: &Context<'_>) -> Result<Vec<Vec<String>>, Error> {
-    use crate::scenes::{load_scenes, reference};
-    use sss_render::integrators::separable::Separable;
-    use sss_render::metrics::error_figures;
-    use sss_render::progress::NoProgress;
-    use sss_render::{RenderSettings, render};
     // Only the two scenes whose materials the table is about, if the run includes them.
     let names: Vec<String> = ctx
         .config

@@ -20,7 +20,9 @@
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
 use sss_render::frame::Frame;
-use sss_render::integrators::pathtrace::{DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch};
+use sss_render::integrators::pathtrace::{
+    DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch, probe_radii,
+};
 use sss_render::rng::{Stream, rng};
 use std::time::Instant;
 
@@ -191,16 +193,7 @@ pub fn path_reference(
     log: &dyn Fn(&str),
 ) -> Reference {
     let t0 = Instant::now();
-    let radii: Vec<Option<ProbeRadii>> = frame
-        .shading
-        .iter()
-        .map(|s| s.as_ref().map(|s| ProbeRadii::new(s, DEFAULT_PROBE_ENERGY)))
-        .collect();
-    let missed = radii
-        .iter()
-        .flatten()
-        .flat_map(|r| r.missed)
-        .fold(0.0, f64::max);
+    let (radii, missed) = probe_radii(&frame.shading, DEFAULT_PROBE_ENERGY);
     let gb = &frame.gbuffer;
     let k = f64::from(gb.samples_per_pixel.max(1));
     // The translucent camera samples of each pixel.

@@ -60,16 +60,11 @@ pub(in super::super) fn reference(
     let path = dir.join(format!("scene_{}_{key:016x}.exr", scene.name));
     let meta = path.with_extension("txt");
     if !cfg.fresh {
-        match load(&path, &meta, scene.camera.width, scene.camera.height) {
-            Ok(Some(r)) => {
-                (ctx.log)(&format!("scene {}: reference from cache", scene.name));
-                return Ok(r);
-            }
-            Ok(None) => {}
-            Err(reason) => (ctx.log)(&format!(
-                "scene {}: cached reference is corrupt ({reason}), recomputing",
-                scene.name
-            )),
+        let subject = format!("scene {}", scene.name);
+        let read = load(&path, &meta, scene.camera.width, scene.camera.height);
+        if let Some(r) = checked::usable(read, &subject, "reference", ctx.log) {
+            (ctx.log)(&format!("{subject}: reference from cache"));
+            return Ok(r);
         }
     }
     (ctx.log)(&format!(

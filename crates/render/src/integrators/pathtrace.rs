@@ -37,7 +37,9 @@
 //! irradiance samples, so it is the ground truth for the whole pipeline, sample density
 //! included.
 
-pub use crate::probe::{ChordHits, DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch};
+pub use crate::probe::{
+    ChordHits, DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch, probe_radii,
+};
 
 use super::{Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep};
 use crate::Error;
@@ -138,17 +140,9 @@ impl Integrator for PathTrace {
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
         let scene = frame.scene;
         let t = std::time::Instant::now();
-        let radii: Vec<Option<ProbeRadii>> = frame
-            .shading
-            .iter()
-            .map(|s| s.as_ref().map(|s| ProbeRadii::new(s, self.probe_energy)))
-            .collect();
-        // The largest energy fraction never sampled, over the materials the image shows.
-        let missed = radii
-            .iter()
-            .flatten()
-            .flat_map(|r| r.missed)
-            .fold(0.0, f64::max);
+        // `missed`: the largest energy fraction never sampled, over the materials the image
+        // shows.
+        let (radii, missed) = probe_radii(&frame.shading, self.probe_energy);
         let spp = self.spp.max(1);
         let sampler = |shading, radii| Sampler {
             geom: &frame.geom,

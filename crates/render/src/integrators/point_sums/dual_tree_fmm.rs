@@ -103,8 +103,8 @@
 
 use super::{
     Counts, ObjectPoints, PIXEL_LEAF, TASK_ITEMS, accepts, add_samples, eps_sweep,
-    for_each_dual_object, illumination_tree_bytes, illumination_trees, pixel_trees, rd_times,
-    shading_points, task_slices,
+    for_each_dual_object, illumination_tree_bytes, illumination_trees, pixel_point, pixel_trees,
+    rd_times, shading_points, task_slices,
 };
 use crate::Error;
 use crate::frame::Frame;
@@ -680,19 +680,7 @@ fn plain_points(frame: &Frame<'_>) -> ObjectPoints {
             .collect();
         let points = index
             .iter()
-            .map(|&i| {
-                let g = &frame.gbuffer.samples[i as usize];
-                PixelPoint {
-                    screen: [
-                        f64::from(g.pixel % width) + 0.5,
-                        f64::from(g.pixel / width) + 0.5,
-                    ],
-                    position: g.p,
-                    normal: g.n,
-                    view: g.wo,
-                    rate: 0.0,
-                }
-            })
+            .map(|&i| pixel_point(&frame.gbuffer.samples[i as usize], width, 0.0))
             .collect();
         out[o as usize] = Some((points, index));
     }

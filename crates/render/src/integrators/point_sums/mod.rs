@@ -243,6 +243,21 @@ pub fn curvature_at_hits(frame: &Frame<'_>, o: u32) -> Result<(Vec<u32>, Vec<f64
     Ok((index, curvature))
 }
 
+/// The shading point of G-buffer sample `g` in a frame `width` pixels wide (at its pixel's
+/// centre on screen), with sampling rate `rate`.
+pub(crate) fn pixel_point(g: &GSample, width: u32, rate: f64) -> PixelPoint {
+    PixelPoint {
+        screen: [
+            f64::from(g.pixel % width) + 0.5,
+            f64::from(g.pixel / width) + 0.5,
+        ],
+        position: g.p,
+        normal: g.n,
+        view: g.wo,
+        rate,
+    }
+}
+
 /// The shading points of every visible translucent object with their s_p, and the G-buffer
 /// index of each, per object.
 pub(crate) type ObjectPoints = Vec<Option<(Vec<PixelPoint>, Vec<u32>)>>;
@@ -282,16 +297,7 @@ pub(crate) fn shading_points(frame: &Frame<'_>) -> Result<ObjectPoints, Error> {
             .map(|(&i, &k_scene)| {
                 let g = &frame.gbuffer.samples[i as usize];
                 let rate = rate_at(g, k_scene, sh, bw, &footprint)?;
-                Ok(PixelPoint {
-                    screen: [
-                        f64::from(g.pixel % width) + 0.5,
-                        f64::from(g.pixel / width) + 0.5,
-                    ],
-                    position: g.p,
-                    normal: g.n,
-                    view: g.wo,
-                    rate,
-                })
+                Ok(pixel_point(g, width, rate))
             })
             .collect::<Result<_, Error>>()?;
         out[o as usize] = Some((points, index));

@@ -56,7 +56,7 @@ use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::options::{IRRADIANCE_POINTS, MAX_PAIRS, UNIFORM_POINTS};
 use crate::integrators::{Layer, MethodOptions, OptionSpec, Shaded, Stat, check_radial};
-use crate::probe::{DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch};
+use crate::probe::{DEFAULT_PROBE_ENERGY, Sampler, Scratch, probe_radii};
 use crate::progress::Progress;
 use crate::rng::{Stream, rng};
 use crate::vpls::vpl_count;
@@ -279,20 +279,12 @@ fn estimate_pixels<E: PixelEstimator>(
     let geom = &frame.geom;
     let gb = &frame.gbuffer;
     let list = pixel_list(frame, only, method)?;
-    let radii: Vec<Option<ProbeRadii>> = frame
-        .shading
-        .iter()
-        .map(|s| {
-            s.as_ref()
-                .filter(|_| !opts.uniform)
-                .map(|s| ProbeRadii::new(s, DEFAULT_PROBE_ENERGY))
-        })
-        .collect();
-    let missed = radii
-        .iter()
-        .flatten()
-        .flat_map(|r| r.missed)
-        .fold(0.0, f64::max);
+    // Uniform points need no probe spheres.
+    let (radii, missed) = if opts.uniform {
+        (frame.shading.iter().map(|_| None).collect(), 0.0)
+    } else {
+        probe_radii(&frame.shading, DEFAULT_PROBE_ENERGY)
+    };
     // Shadow rays from the gather point to the VPL, as `manylight`'s.
     let visibility = shadow_test(frame);
     let spp = gb.samples_per_pixel as f64;
