@@ -4,7 +4,9 @@
 //! wax) and nothing else: a validated [`Medium`], exact [`fresnel`] terms, five diffusion
 //! models and a tabulated Monte Carlo profile ([`mc_table`]) behind one [`Bssrdf`] trait,
 //! importance sampling of their radial profiles, and a Monte Carlo photon random walk
-//! ([`monte_carlo`]) that is the ground truth the models are measured against. It depends on no renderer; everything is `f64`, and every constructor
+//! ([`monte_carlo`]) on the flat half-space under a normal beam, the reference the models'
+//! profiles are measured against (real transport there; on curved objects the renderer's
+//! `volpath` is the reference). It depends on no renderer; everything is `f64`, and every constructor
 //! validates its input and returns a [`BssrdfError`] instead of panicking.
 //!
 //! ```

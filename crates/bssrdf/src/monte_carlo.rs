@@ -1,4 +1,5 @@
-//! Monte Carlo photon random walk: the ground truth the diffusion models are measured against.
+//! Monte Carlo photon random walk: the reference the diffusion models' profiles are measured
+//! against (real light transport, for a flat half-space under a normal beam).
 //!
 //! A pencil beam enters a semi-infinite homogeneous [`Medium`] (occupying z < 0, under a smooth
 //! dielectric boundary z = 0 of relative index η) at normal incidence at the origin; photons

@@ -4,7 +4,7 @@
 //! Kernels come from `sss-separable`.
 //!
 //! `KernelMethod::Exact2d` replaces the separable pass by the brute-force 2D screen-space
-//! convolution with the full discretised kernel at the same footprint: the ground truth of the
+//! convolution with the full discretised kernel at the same footprint: the reference of the
 //! separable approximation itself (as opposed to the world-space `exact` reference, which
 //! also includes what screen space cannot see).
 
@@ -35,7 +35,8 @@ pub enum KernelMethod {
     Gaussians1,
     /// Six Gaussians (12 passes).
     Gaussians6,
-    /// The exact 2D screen-space convolution with the full kernel (ground truth).
+    /// The exact 2D screen-space convolution with the full kernel (the separable kernels'
+    /// reference).
     Exact2d,
 }
 

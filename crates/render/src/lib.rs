@@ -3,11 +3,12 @@
 //! A thin library composing the toolkit's crates behind one integrator interface: ray casting
 //! (one exact BVH per object, `sss-hierarchy`), the G-buffer, direct lighting with shadow rays,
 //! irradiance samples, the [`integrators`] and their registry, image output (EXR, PNG) and
-//! image [`metrics`]. The nine methods come in families (`integrators/`): the point sums
+//! image [`metrics`]. The ten methods come in families (`integrators/`): the point sums
 //! `exact`, `single-tree`, `dual-tree` and `dual-tree-fmm` (sums over irradiance samples,
 //! exactly or through trees); the VPL methods `manylight`, `mdlc` and `eelc` (many-light
-//! estimators over virtual point lights); the `pathtrace` reference; and the screen-space
-//! `separable` pass. Use it to render a scene from code ([`render`]) or to add a method; the
+//! estimators over virtual point lights); the `pathtrace` reference of each model; the
+//! screen-space `separable` pass; and `volpath`, volumetric path tracing of the media in the
+//! meshes, the reference of real light transport that no model is bound to. Use it to render a scene from code ([`render`]) or to add a method; the
 //! `sss` binary (crate `sss-cli`) and `cargo xtask compare` are thin layers over it. It pulls in
 //! no CLI, progress-bar or plotting crate: progress reaches the caller through
 //! [`progress::Progress`].
@@ -64,7 +65,8 @@
 //!   lightcuts, `eelc`).
 //! - Pharr, Jakob & Humphreys, *Physically Based Rendering* 3rd ed., §11.4 and §15.4: the
 //!   separable BSSRDF S_ω normalisation and BSSRDF importance sampling with probe rays
-//!   (`pathtrace`, [`probe`]).
+//!   (`pathtrace`, [`probe`]); §15.3, volumetric path tracing (`volpath`), with pbrt-v4's
+//!   spectral multiple importance sampling of chromatic media.
 //! - Jimenez et al. 2015, *Separable Subsurface Scattering*: the screen-space pass
 //!   (`separable`, kernels from `sss-separable`).
 //! - The models of `sss-bssrdf` (Jensen et al. 2001, d'Eon 2012, Frisvad et al. 2014, Habel et
@@ -89,6 +91,7 @@ pub mod probe;
 pub mod progress;
 pub mod rng;
 pub mod shading;
+pub mod volume;
 pub mod vpls;
 
 pub use error::Error;

@@ -26,6 +26,8 @@ pub enum Stream {
     /// The fixed irradiance points of the many-light baselines (`mdlc`, `eelc`; per pixel
     /// sample).
     IrradiancePoints = 8,
+    /// Paths of the volumetric path tracer (per pixel sample).
+    Volume = 9,
 }
 
 /// The generator for work item `index` of `stream` under `seed`.

@@ -4,12 +4,12 @@
 //! [`sss_bssrdf::Medium`]) into the small 1D kernels a real-time screen-space
 //! subsurface-scattering pass convolves with, to measure how far each kernel is from the true
 //! 2D diffusion kernel, and to run that pass on the CPU ([`screen_space`]) next to its exact
-//! 2D ground truth ([`convolve2d`]). It implements every kernel of Jimenez et al. 2015 and the
+//! 2D convolution ([`convolve2d`]). It implements every kernel of Jimenez et al. 2015 and the
 //! sum-of-Gaussians baseline they compare against:
 //!
 //! | kernel | module | passes | paper |
 //! |---|---|---|---|
-//! | discretised R_d(x, y), the ground truth | [`kernel2d`] | (N² taps) | §3, Eq. 1 |
+//! | discretised R_d(x, y), the kernels' reference | [`kernel2d`] | (N² taps) | §3, Eq. 1 |
 //! | rank-k SVD, k = 1..6, and the spectrum | [`svd`] | 2k | §3, Eq. 2, Fig. 2, 4 |
 //! | pre-integrated rank-1 | [`preintegrated`] | 2 | §4, Eq. 4–5 |
 //! | artist-friendly two-Gaussian (Table 2 presets, fitter) | [`artist`] | 2 | §5, Eq. 6 |

@@ -26,7 +26,7 @@ mod tests;
 pub(super) use cache::{reference, reference_method};
 pub use load::default_mesh_dirs;
 pub(super) use load::load_scenes;
-pub(super) use plan::{PlanOutline, SceneInfo, ScenePlan, SweepUnit, plan};
+pub(super) use plan::{PlanOutline, SceneInfo, ScenePlan, SweepUnit, plan, swept};
 pub(super) use report::assemble;
 pub(super) use runs::{Run, UnitResult, escape, unescape};
 
@@ -40,7 +40,7 @@ use sss_plot::{PALETTE, Series, SeriesStyle, line_plot};
 use sss_render::RenderSettings;
 use sss_render::image::{auto_exposure, write_png};
 use sss_render::integrators::exact::reference_spacing;
-use sss_render::integrators::{METHODS, MethodOptions};
+use sss_render::integrators::{Converges, METHODS, Method, MethodOptions};
 use sss_render::metrics::{error_figures, frac_within_se, mean_ratio};
 use sss_render::scene::Scene;
 use std::fmt::Write as _;

@@ -15,10 +15,13 @@ pub(crate) struct SweepUnit {
 
 impl SweepUnit {
     /// Every unit of `scenes` scenes, in report order: scene, then method, then sweep value.
+    /// Only the methods that converge to their material's model are swept (the experiment
+    /// scores them against `exact` with that model); `volpath`, which converges to light
+    /// transport itself, is scored by `--truth`.
     pub fn all(scenes: usize, quick: bool) -> Vec<SweepUnit> {
         let mut units = Vec::new();
         for scene in 0..scenes {
-            for (method, m) in METHODS.iter().enumerate() {
+            for (method, m) in METHODS.iter().enumerate().filter(|(_, m)| swept(m)) {
                 for value in 0..(m.sweep.values)(quick).len() {
                     units.push(SweepUnit {
                         scene,
@@ -68,6 +71,11 @@ impl ScenePlan {
             units: self.units.clone(),
         }
     }
+}
+
+/// Whether the experiment sweeps method `m`: those bound to their material's model.
+pub(crate) fn swept(m: &Method) -> bool {
+    m.converges_to == Converges::Model
 }
 
 /// Loads the run's scenes and lists the units of the sweep.

@@ -56,7 +56,7 @@ pub(crate) fn assemble(
         let firsts =
             |mi: usize| -> Vec<&Run> { unit_runs[si][mi].iter().map(|&k| &runs[k]).collect() };
         let mut series = Vec::new();
-        for (mi, m) in METHODS.iter().enumerate() {
+        for (mi, m) in METHODS.iter().enumerate().filter(|(_, m)| swept(m)) {
             let points: Vec<(f64, f64)> = firsts(mi)
                 .iter()
                 .map(|r| (r.seconds_total(), r.rmse))

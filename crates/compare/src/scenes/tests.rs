@@ -124,3 +124,18 @@ fn every_csv_column_is_documented() {
         Vec::<String>::new()
     );
 }
+
+/// The sweep scores methods against `exact` with their own model: every model-bound method
+/// has units, `volpath` (bound to no model) none.
+#[test]
+fn the_sweep_runs_every_model_bound_method_and_not_volpath() {
+    let units = SweepUnit::all(2, true);
+    for (mi, m) in METHODS.iter().enumerate() {
+        let n = units.iter().filter(|u| u.method == mi).count();
+        if m.name == "volpath" {
+            assert_eq!(n, 0);
+        } else {
+            assert_eq!(n, 2 * (m.sweep.values)(true).len(), "{}", m.name);
+        }
+    }
+}

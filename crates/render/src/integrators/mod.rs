@@ -23,7 +23,9 @@
 //! - [`vpl`]: many-light methods over virtual point lights — [`manylight`], and under
 //!   [`vpl::gather_points`] (the fixed gather-point pipeline) [`mdlc`] and [`eelc`];
 //! - [`pathtrace`] (its probe sampler is [`crate::probe`], which the gather-point pipeline
-//!   also draws with) and [`separable`] stand alone.
+//!   also draws with) and [`separable`] stand alone;
+//! - [`volpath`]: volumetric path tracing of the media themselves (its physics is
+//!   [`crate::volume`]), the one method bound to no BSSRDF model ([`Converges::Transport`]).
 //!
 //! Option specs more than one method takes are named constants in [`options`]; a method
 //! lists the ones it takes by name. No method file imports from a sibling method file (a
@@ -40,6 +42,7 @@ pub mod options;
 pub mod pathtrace;
 pub mod point_sums;
 pub mod separable;
+pub mod volpath;
 pub mod vpl;
 
 pub use options::{MethodOptions, OptionKind, OptionSpec};
@@ -49,6 +52,7 @@ pub use vpl::manylight;
 
 use crate::Error;
 use crate::frame::Frame;
+use crate::gbuffer::GBuffer;
 use crate::irradiance::IrradianceSettings;
 use crate::progress::Progress;
 use sss_bssrdf::Rgb;
@@ -125,6 +129,17 @@ pub struct Sweep {
     pub values: fn(bool) -> Vec<f64>,
 }
 
+/// What a method's image converges to as its parameters are refined.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Converges {
+    /// The sum or integral of the material's BSSRDF model (every model-based method): scored
+    /// against `exact` with the same model.
+    Model,
+    /// Light transport itself in the scene's geometry (`volpath`): no model; scored against
+    /// itself at many samples, and the models against it (`cargo xtask compare --truth`).
+    Transport,
+}
+
 /// A registry entry: everything the CLI, `compare` and the pipeline need to know of a method.
 #[derive(Clone, Copy, Debug)]
 pub struct Method {
@@ -139,6 +154,9 @@ pub struct Method {
     pub build: fn(&MethodOptions) -> Result<Box<dyn Integrator>, Error>,
     /// Its sweep in `cargo xtask compare`.
     pub sweep: Sweep,
+    /// What its image converges to: the model's sum (scored against `exact` by the default
+    /// comparison) or light transport (scored by `compare --truth`).
+    pub converges_to: Converges,
 }
 
 /// Every rendering method, in report order.
@@ -152,6 +170,7 @@ pub const METHODS: &[Method] = &[
     manylight::METHOD,
     mdlc::METHOD,
     eelc::METHOD,
+    volpath::METHOD,
 ];
 
 /// The registry entry named `name`.
@@ -178,6 +197,39 @@ pub(crate) fn add_scaled(acc: &mut Rgb, v: Rgb, s: f64) {
     for c in 0..3 {
         acc[c] += v[c] * s;
     }
+}
+
+/// The mean of `k` estimates from their sum and sum of squares, and the variance of that mean
+/// (the unbiased sample variance over k; 0 for k = 1).
+pub(crate) fn mean_and_variance(sum: Rgb, sum2: Rgb, k: u32) -> (Rgb, Rgb) {
+    let k = k.max(1) as f64;
+    let mean = sum.map(|s| s / k);
+    let var = [0, 1, 2].map(|c| {
+        if k > 1.0 {
+            ((sum2[c] - k * mean[c] * mean[c]) / (k - 1.0)).max(0.0) / k
+        } else {
+            0.0
+        }
+    });
+    (mean, var)
+}
+
+/// Per pixel, the standard error of its value from the variances of its G-buffer samples'
+/// values (indexed like `gb.samples`): the pixel averages its camera samples, each with weight
+/// 1/(camera samples per pixel), and they are independent.
+pub(crate) fn pixel_std_error(gb: &GBuffer, variances: &[Rgb]) -> Vec<Rgb> {
+    let cs = gb.samples_per_pixel as f64;
+    (0..gb.pixels())
+        .map(|i| {
+            let mut v = [0.0; 3];
+            for k in gb.offsets[i] as usize..gb.offsets[i + 1] as usize {
+                for c in 0..3 {
+                    v[c] += variances[k][c] / (cs * cs);
+                }
+            }
+            v.map(|x| x.sqrt())
+        })
+        .collect()
 }
 
 /// Errors unless every visible translucent material is radial.

@@ -34,14 +34,18 @@
 //! shadow needs many samples (`--spp 4096` on that sphere, `docs/usage.md`), not a larger sphere.
 //!
 //! It converges to the surface integral that the `exact` sum approximates with discrete
-//! irradiance samples, so it is the ground truth for the whole pipeline, sample density
-//! included.
+//! irradiance samples, so it is the reference of the whole pipeline, sample density included,
+//! for the material's BSSRDF model: exact for the model only. Real light transport in the
+//! object, which no model is, is `volpath`'s.
 
 pub use crate::probe::{
     ChordHits, DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch, probe_radii,
 };
 
-use super::{Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep};
+use super::{
+    Converges, Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
+    mean_and_variance, pixel_std_error,
+};
 use crate::Error;
 use crate::frame::Frame;
 use crate::progress::Progress;
@@ -87,6 +91,7 @@ pub const METHOD: Method = Method {
             }
         },
     },
+    converges_to: Converges::Model,
 };
 
 /// The `pathtrace` integrator and its settings.
@@ -175,35 +180,15 @@ impl Integrator for PathTrace {
                         sum2[c] += v[c] * v[c];
                     }
                 }
-                let k = spp as f64;
-                let mean = sum.map(|s| s / k);
-                // Variance of the mean of this sample's spp estimates.
-                let var = [0, 1, 2].map(|c| {
-                    if spp > 1 {
-                        ((sum2[c] - k * mean[c] * mean[c]) / (k - 1.0)).max(0.0) / k
-                    } else {
-                        0.0
-                    }
-                });
+                let (mean, var) = mean_and_variance(sum, sum2, spp);
                 (mean, var)
             })
             .collect();
         frame.record("shading", t.elapsed().as_secs_f64());
         let values: Vec<Rgb> = results.iter().map(|r| r.0).collect();
-        // Pixel standard error: the pixel averages its samples (1/spp_camera each).
+        let variances: Vec<Rgb> = results.iter().map(|r| r.1).collect();
+        let se = pixel_std_error(&frame.gbuffer, &variances);
         let gb = &frame.gbuffer;
-        let cs = gb.samples_per_pixel as f64;
-        let se: Vec<Rgb> = (0..gb.pixels())
-            .map(|i| {
-                let mut v = [0.0; 3];
-                for k in gb.offsets[i] as usize..gb.offsets[i + 1] as usize {
-                    for c in 0..3 {
-                        v[c] += results[k].1[c] / (cs * cs);
-                    }
-                }
-                v.map(|x| x.sqrt())
-            })
-            .collect();
         let shaded = gb
             .samples
             .iter()

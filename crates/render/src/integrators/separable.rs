@@ -10,6 +10,7 @@ use super::{
 };
 use crate::Error;
 use crate::frame::Frame;
+use crate::integrators::Converges;
 use crate::irradiance::IrradianceSettings;
 use crate::kernel_choice::{
     KernelMethod, MaterialKernel, SeparableSettings, build_kernel, filter_options,
@@ -89,6 +90,7 @@ pub const METHOD: Method = Method {
             }
         },
     },
+    converges_to: Converges::Model,
 };
 
 /// Reads and checks the kernel options (`sss render --method separable`, `sss filter`).

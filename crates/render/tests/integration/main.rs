@@ -21,3 +21,6 @@ mod scene_framing;
 mod separable_fast_path;
 mod subset_reference;
 mod trees;
+mod volpath;
+mod volpath_mcml;
+mod volpath_mitsuba;

@@ -108,6 +108,7 @@ use super::{
 };
 use crate::Error;
 use crate::frame::Frame;
+use crate::integrators::Converges;
 use crate::integrators::options::{
     MAX_SAMPLES, SOLID_ANGLE_EPS, SPACING, eps_option, sample_settings,
 };
@@ -173,6 +174,7 @@ pub const METHOD: Method = Method {
         label: "eps",
         values: eps_sweep,
     },
+    converges_to: Converges::Model,
 };
 
 /// The `dual-tree-fmm` integrator and its settings.

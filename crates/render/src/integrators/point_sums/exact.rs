@@ -17,6 +17,7 @@ use crate::Error;
 use crate::frame::Frame;
 use crate::frame::assembled_subsurface;
 use crate::gbuffer::GSample;
+use crate::integrators::Converges;
 use crate::integrators::options::SAMPLE_OPTIONS;
 use crate::integrators::options::sample_settings;
 use crate::integrators::{Integrator, Method, MethodOptions, Shaded, Stat, Sweep, add_scaled};
@@ -52,6 +53,7 @@ pub const METHOD: Method = Method {
                 .collect()
         },
     },
+    converges_to: Converges::Model,
 };
 
 /// The `exact` integrator and its settings.

@@ -20,6 +20,7 @@ use super::{
 };
 use crate::Error;
 use crate::frame::Frame;
+use crate::integrators::Converges;
 use crate::integrators::options::{
     MAX_SAMPLES, SOLID_ANGLE_EPS, SPACING, eps_option, sample_settings,
 };
@@ -49,6 +50,7 @@ pub const METHOD: Method = Method {
         label: "eps",
         values: eps_sweep,
     },
+    converges_to: Converges::Model,
 };
 
 /// The `single-tree` integrator and its settings.

@@ -57,6 +57,7 @@ use super::{
 };
 use crate::Error;
 use crate::frame::Frame;
+use crate::integrators::Converges;
 use crate::integrators::options::{ALPHA, RELATIVE_EPS, VPLS, alpha_option, eps_option};
 use crate::integrators::{
     Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
@@ -149,6 +150,7 @@ pub const METHOD: Method = Method {
             }
         },
     },
+    converges_to: Converges::Model,
 };
 
 /// The `manylight` integrator and its settings.

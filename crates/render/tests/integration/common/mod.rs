@@ -18,8 +18,8 @@ use std::f64::consts::PI;
 
 /// Cheap options per registered method, for tests that run every method on a small frame and
 /// check properties that do not depend on accuracy (finite values, exact zeros, coverage,
-/// determinism): the point-based methods on coarse irradiance samples, 2 paths per pixel,
-/// and 32 irradiance points per shading point for the MDLC / EELC baselines (their default,
+/// determinism): the point-based methods on coarse irradiance samples, 2 paths per pixel
+/// (`volpath` with its Lambertian boundary), and 32 irradiance points per shading point for the MDLC / EELC baselines (their default,
 /// 4096, takes about 12 s a render even on a 24×18 frame).
 pub fn cheap(name: &str) -> MethodOptions {
     match name {
@@ -28,6 +28,11 @@ pub fn cheap(name: &str) -> MethodOptions {
         }
         "pathtrace" => MethodOptions::new().with("spp", 2),
         "mdlc" | "eelc" => MethodOptions::new().with("irradiance-points", 32),
+        // The Lambertian boundary reaches every light kind, so the shared scenes (point and
+        // directional lights) render; the dielectric boundary is tested on its own.
+        "volpath" => MethodOptions::new()
+            .with("spp", 2)
+            .with("boundary", "lambertian"),
         _ => MethodOptions::new(),
     }
 }

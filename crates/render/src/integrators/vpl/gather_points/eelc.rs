@@ -17,6 +17,7 @@
 use super::{PixelEstimator, PointOptions, Prepared};
 use crate::Error;
 use crate::frame::Frame;
+use crate::integrators::Converges;
 use crate::integrators::options::{
     ALPHA, IRRADIANCE_POINTS, MAX_PAIRS, RELATIVE_EPS, UNIFORM_POINTS, VPLS, alpha_option,
     eps_option,
@@ -48,6 +49,7 @@ pub const METHOD: Method = Method {
         label: "points",
         values: super::sweep_points,
     },
+    converges_to: Converges::Model,
 };
 
 /// The `eelc` integrator and its settings.

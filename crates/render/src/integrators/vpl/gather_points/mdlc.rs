@@ -16,6 +16,7 @@
 use super::{PixelEstimator, PointOptions, Prepared};
 use crate::Error;
 use crate::frame::Frame;
+use crate::integrators::Converges;
 use crate::integrators::options::{IRRADIANCE_POINTS, MAX_PAIRS, UNIFORM_POINTS, VPLS, eps_option};
 use crate::integrators::vpl::PixelResult;
 use crate::integrators::{
@@ -57,6 +58,7 @@ pub const METHOD: Method = Method {
         // (measured times: `docs/compare.md`).
         values: super::sweep_points,
     },
+    converges_to: Converges::Model,
 };
 
 /// The `mdlc` integrator and its settings.
