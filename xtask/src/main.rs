@@ -152,6 +152,17 @@ struct CompareArgs {
     /// (with --trees, both).
     #[arg(long)]
     manylight: bool,
+    /// Run only the truth experiment: every BSSRDF model, the fast methods and volpath itself
+    /// against volumetric light transport (volpath's reference) on spheres, the bunny, the
+    /// head and the dragon (meshes from the shared meshes) in four media under a quad or an
+    /// environment light; about an hour on 2 cores, a minute with --quick.
+    #[arg(long)]
+    truth: bool,
+    /// With --truth: render every case with Mitsuba 3 and Blender Cycles too (their Python
+    /// packages, found through SSS_PEERS_PYTHON or python3), on the same axes; a peer whose
+    /// package is missing is skipped with a sentence saying how to install it.
+    #[arg(long, requires = "truth")]
+    peers: bool,
     /// Run only the I-th of N balanced shares of the default experiments (e.g. 2/8) into
     /// --out, for a cluster's array job; join the shares with --merge. Shards share the
     /// references through --cache (fill it first with --prepare).
@@ -346,6 +357,8 @@ fn main() -> ExitCode {
                 quick: args.quick,
                 trees: args.trees,
                 manylight: args.manylight,
+                truth: args.truth,
+                peers: args.peers,
                 shard: args.shard,
                 merge: args.merge,
                 prepare: args.prepare,

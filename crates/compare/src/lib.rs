@@ -12,7 +12,8 @@
 //!    contributes a report [`Section`] plus its own files: `profiles` (every model's radial
 //!    profile against Monte Carlo), `scenes` (every rendering method over its sweep) and
 //!    `kernels` (the separable kernels) by default; `trees` and `manylight`, the paper-scale
-//!    experiments, by their flags.
+//!    experiments, and `truth` (every model against volumetric light transport), by their
+//!    flags.
 //! 3. `report.md` is assembled from the sections.
 //!
 //! Each experiment is a module of its own, split by concern (its plan, runs, scoring, plots
@@ -44,7 +45,8 @@
 //! What it measures is the other crates' (their docs cite the papers); the experiments test
 //! the claims of Jensen et al. 2001 and d'Eon 2012 (profiles against MCML-style Monte Carlo,
 //! Wang et al. 1995), Jimenez et al. 2015 (kernels), Milaenen et al. 2019 (`trees`) and Nabata
-//! & Iwasaki 2021 (`manylight`, with Walter et al. 2006 and Sakai et al. 2019 as baselines).
+//! & Iwasaki 2021 (`manylight`, with Walter et al. 2006 and Sakai et al. 2019 as baselines);
+//! `truth` scores every model against volumetric path tracing (pbrt 3rd ed. §15.3).
 
 #![forbid(unsafe_code)]
 
@@ -59,6 +61,7 @@ mod scenes;
 mod shard;
 mod subset;
 mod trees;
+mod truth;
 
 pub use scenes::default_mesh_dirs;
 pub use shard::Shard;
@@ -107,6 +110,11 @@ pub struct Config {
     pub trees: bool,
     /// Run only the paper-scale many-light experiments (module `manylight`).
     pub manylight: bool,
+    /// Run only the truth experiment: every model against volumetric light transport (module
+    /// `truth`).
+    pub truth: bool,
+    /// With `truth`: render its cases with the peers too (Mitsuba 3), when installed.
+    pub peers: bool,
     /// Run only this share of the default experiments (module `shard`).
     pub shard: Option<Shard>,
     /// Join these shard directories into `out` instead of running anything (module `shard`).
@@ -133,6 +141,8 @@ impl Config {
             quick: false,
             trees: false,
             manylight: false,
+            truth: false,
+            peers: false,
             shard: None,
             merge: Vec::new(),
             prepare: false,
@@ -140,9 +150,9 @@ impl Config {
         }
     }
 
-    /// True when only paper-scale experiments run (they use no Monte Carlo reference).
+    /// True when only flagged experiments run (they use no Monte Carlo reference).
     pub fn paper_only(&self) -> bool {
-        self.trees || self.manylight
+        self.trees || self.manylight || self.truth
     }
 
     /// Where references are cached: `--cache`, or `cache/` in the output directory.
@@ -206,8 +216,9 @@ pub trait Experiment {
 pub enum Selection {
     /// In every default run (and in its shards and merges).
     Default,
-    /// Only when asked for by its own flag (`--trees`, `--manylight`): a paper-scale
-    /// experiment, which needs no Monte Carlo reference and runs instead of the default ones.
+    /// Only when asked for by its own flag (`--trees`, `--manylight`, `--truth`): a
+    /// paper-scale or long experiment, which needs no Monte Carlo reference and runs instead of
+    /// the default ones.
     Flag(&'static str),
 }
 
@@ -256,6 +267,13 @@ pub const EXPERIMENTS: &[ExperimentEntry] = &[
         selection: Selection::Flag("manylight"),
         build: || Box::new(manylight::ManyLightExperiment),
     },
+    ExperimentEntry {
+        name: "truth",
+        about: "every model, the fast methods and volpath itself against volumetric light \
+                transport (volpath's reference)",
+        selection: Selection::Flag("truth"),
+        build: || Box::new(truth::TruthExperiment),
+    },
 ];
 
 /// The experiments `config` selects, in report order: those whose flag it sets, or the
@@ -264,6 +282,7 @@ fn experiments(config: &Config) -> Vec<Box<dyn Experiment>> {
     let flagged = |f: &str| match f {
         "trees" => config.trees,
         "manylight" => config.manylight,
+        "truth" => config.truth,
         _ => false,
     };
     EXPERIMENTS
@@ -310,7 +329,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
     if sharding && config.paper_only() {
         return Err(Error(
             "--shard, --prepare and --merge split the default experiments; they do not go \
-             with --trees or --manylight"
+             with --trees, --manylight or --truth"
                 .into(),
         ));
     }
@@ -447,5 +466,8 @@ mod registry_tests {
         assert_eq!(names(&c), ["trees", "manylight"]);
         c.trees = false;
         assert_eq!(names(&c), ["manylight"]);
+        c.manylight = false;
+        c.truth = true;
+        assert_eq!(names(&c), ["truth"]);
     }
 }

@@ -2,7 +2,9 @@
 //!
 //! Runs a scene of the toolkit in the renderers users would otherwise reach for, so that
 //! images can be compared like for like: Mitsuba 3 (its Python package, the `scalar_rgb`
-//! variant and `volpathmis`, a smooth `dielectric` around a `homogeneous` medium). Use it to
+//! variant and `volpathmis`, a smooth `dielectric` around a `homogeneous` medium) and Blender
+//! Cycles (the `bpy` package: the medium inside glass, or its random-walk and
+//! Christensen–Burley subsurface at Cycles' own parameters, [`CyclesMode`]). Use it to
 //! check a renderer against code we did not write, or to put a peer on the same
 //! error-against-time axes as our methods.
 //!
@@ -52,6 +54,9 @@ use std::process::Command;
 
 /// The Mitsuba 3 script (`scripts/mitsuba_render.py`).
 pub const MITSUBA_SCRIPT: &str = include_str!("../scripts/mitsuba_render.py");
+
+/// The Blender Cycles script (`scripts/cycles_render.py`).
+pub const CYCLES_SCRIPT: &str = include_str!("../scripts/cycles_render.py");
 
 /// The environment variable naming the Python interpreter that has the peers' packages.
 pub const PYTHON_VAR: &str = "SSS_PEERS_PYTHON";
@@ -195,9 +200,13 @@ pub fn export(scene: &Scene, dir: &Path) -> Result<PathBuf, Error> {
         write_atomic(&p, mesh_obj(&o.mesh).as_bytes())
             .map_err(|e| io_error("cannot write", &p, e))?;
     }
-    let script = dir.join("mitsuba_render.py");
-    write_atomic(&script, MITSUBA_SCRIPT.as_bytes())
-        .map_err(|e| io_error("cannot write", &script, e))?;
+    for (name, text) in [
+        ("mitsuba_render.py", MITSUBA_SCRIPT),
+        ("cycles_render.py", CYCLES_SCRIPT),
+    ] {
+        let script = dir.join(name);
+        write_atomic(&script, text.as_bytes()).map_err(|e| io_error("cannot write", &script, e))?;
+    }
     let p = dir.join("scene.json");
     let text = serde_json::to_string_pretty(&scene_json(scene))
         .map_err(|e| Error(format!("cannot format {}: {e}", p.display())))?;
@@ -355,26 +364,110 @@ pub fn render_mitsuba(
     mode: &str,
     name: &str,
 ) -> Result<PeerRender, Error> {
+    let args = [
+        ("--spp", run.spp.to_string()),
+        ("--batches", run.batches.max(1).to_string()),
+        ("--seed", run.seed.to_string()),
+        ("--threads", run.threads.to_string()),
+        ("--mode", mode.to_string()),
+        ("--rr-depth", run.rr_depth.to_string()),
+    ];
+    run_script(python, "mitsuba_render.py", scene_json, name, &args)
+}
+
+/// Blender Cycles' ways to render a medium: the medium itself inside glass, or its subsurface
+/// closures at Cycles' own parameters (inverted from the medium by `cycles_render.py`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CyclesMode {
+    /// A smooth Glass BSDF around Volume Absorption + Volume Scatter: the same physics as
+    /// Mitsuba's and `volpath`'s.
+    Volume,
+    /// The Principled BSDF's "Random Walk" subsurface.
+    RandomWalk,
+    /// The Principled BSDF's "Random Walk (Skin)" subsurface.
+    RandomWalkSkin,
+    /// The Principled BSDF's "Christensen-Burley" subsurface.
+    Burley,
+}
+
+impl CyclesMode {
+    /// Every mode, in report order.
+    pub const ALL: [CyclesMode; 4] = [
+        CyclesMode::Volume,
+        CyclesMode::RandomWalk,
+        CyclesMode::RandomWalkSkin,
+        CyclesMode::Burley,
+    ];
+
+    /// The script's name for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            CyclesMode::Volume => "volume",
+            CyclesMode::RandomWalk => "random-walk",
+            CyclesMode::RandomWalkSkin => "random-walk-skin",
+            CyclesMode::Burley => "burley",
+        }
+    }
+}
+
+/// One Cycles run's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CyclesRun {
+    /// Samples per pixel of each batch.
+    pub spp: u32,
+    /// Independent images, seeded `seed`, `seed + 1`, ...
+    pub batches: u32,
+    /// Cycles' seed of the first batch.
+    pub seed: u64,
+    /// Threads (0: Blender's default, all cores).
+    pub threads: usize,
+    /// How the medium is rendered.
+    pub mode: CyclesMode,
+}
+
+/// Runs the Cycles script on `scene_json` (from [`export`]), writing `<scene dir>/<name>.f32|json`;
+/// returns the batches. Cycles hides the lights from glossy rays instead of subtracting a
+/// render, so its image is the subsurface term directly.
+pub fn render_cycles(
+    python: &Path,
+    scene_json: &Path,
+    run: &CyclesRun,
+    name: &str,
+) -> Result<PeerRender, Error> {
+    let args = [
+        ("--spp", run.spp.to_string()),
+        ("--batches", run.batches.max(1).to_string()),
+        ("--seed", run.seed.to_string()),
+        ("--threads", run.threads.to_string()),
+        ("--mode", run.mode.name().to_string()),
+    ];
+    run_script(python, "cycles_render.py", scene_json, name, &args)
+}
+
+/// Runs `script` (written next to `scene_json` by [`export`]) with `args`, and reads what it
+/// wrote to `<scene dir>/<name>`.
+fn run_script(
+    python: &Path,
+    script: &str,
+    scene_json: &Path,
+    name: &str,
+    args: &[(&str, String)],
+) -> Result<PeerRender, Error> {
     let dir = scene_json.parent().unwrap_or(Path::new("."));
-    let script = dir.join("mitsuba_render.py");
     let prefix = dir.join(name);
-    let out = Command::new(python)
-        .arg(&script)
-        .arg(scene_json)
-        .arg(&prefix)
-        .args(["--spp", &run.spp.to_string()])
-        .args(["--batches", &run.batches.max(1).to_string()])
-        .args(["--seed", &run.seed.to_string()])
-        .args(["--threads", &run.threads.to_string()])
-        .args(["--mode", mode])
-        .args(["--rr-depth", &run.rr_depth.to_string()])
+    let mut cmd = Command::new(python);
+    cmd.arg(dir.join(script)).arg(scene_json).arg(&prefix);
+    for (k, v) in args {
+        cmd.arg(k).arg(v);
+    }
+    let out = cmd
         .output()
         .map_err(|e| Error(format!("cannot run {}: {e}", python.display())))?;
     if !out.status.success() {
         let err = String::from_utf8_lossy(&out.stderr);
         let tail: Vec<&str> = err.lines().rev().take(3).collect();
         return Err(Error(format!(
-            "mitsuba on {} failed ({}): {}",
+            "{script} on {} failed ({}): {}",
             scene_json.display(),
             out.status,
             tail.into_iter().rev().collect::<Vec<_>>().join(" | ")
@@ -481,5 +574,41 @@ mod tests {
         let e = read_render(&prefix).unwrap_err().to_string();
         assert!(e.contains("bad size"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Cycles' albedo fit and its inversion (in the script, run by Python with numpy): at
+    /// g = 0 the base colour 0.620 gives skin1's red single-scattering albedo 0.9585
+    /// (`../shared/docs/peers-howto.md`: skin1 inverted to 0.620 / 0.381 / 0.239), and the
+    /// bisection inverts the fit to 10⁻⁹ for g in [0, 0.9] (Cycles' range). Skips without numpy.
+    #[test]
+    fn the_cycles_script_inverts_its_albedo_fit() {
+        let Ok(python) = find_python(&["numpy"]) else {
+            eprintln!("skipped: no Python with numpy");
+            return;
+        };
+        let dir = std::env::temp_dir().join(format!("sss-peers-cycles-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let script = dir.join("cycles_render.py");
+        std::fs::write(&script, CYCLES_SCRIPT).unwrap();
+        let code = format!(
+            "import importlib.util as u\n\
+             s = u.spec_from_file_location('c', {:?}); m = u.module_from_spec(s); \
+             s.loader.exec_module(m)\n\
+             print(m.cycles_alpha(0.620, 0.0))\n\
+             for (a, g) in [(0.3, 0.0), (0.9585, 0.0), (0.99, 0.5), (0.7, 0.3), (0.5, 0.9)]:\n    \
+                 A = m.invert_alpha(a, g); print(abs(m.cycles_alpha(A, g) - a))\n",
+            script.display().to_string()
+        );
+        let out = Command::new(&python).args(["-c", &code]).output().unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8_lossy(&out.stdout).to_string();
+        let v: Vec<f64> = text.lines().map(|l| l.trim().parse().unwrap()).collect();
+        assert!((v[0] - 0.9585).abs() < 5e-4, "{}", v[0]);
+        assert!(v[1..].iter().all(|e| *e < 1e-9), "{v:?}");
     }
 }

@@ -1,0 +1,191 @@
+//! The runs of one case, each scored against its reference: every model under `exact`, the
+//! fast methods over their sweeps (with `mc-table`, the model the scene files name), and
+//! `volpath` itself over its paths per pixel (with another seed than the reference's, so its
+//! error is its own noise).
+
+use super::*;
+
+/// The fast methods scored against the truth, with the model of the scene files.
+pub const FAST: [&str; 3] = ["dual-tree-fmm", "manylight", "separable"];
+
+/// `exact`'s cap on irradiance samples per object here. `exact` costs pixels × samples: on
+/// the true-size head the default cap (10⁵, samples 2.5 mean free paths apart) took 85 s a
+/// model and still differed from this cap's image (4.5 apart, 32 s) by 25 % relative RMSE
+/// (image means within 0.4 %), so there the models' floors come from `pathtrace`, which
+/// discretises nothing; a capped run is marked in the `warnings` column.
+pub const EXACT_SAMPLES: usize = 30_000;
+
+/// `pathtrace`'s BSSRDF samples per pixel sample for the models' floors.
+pub const PATHTRACE_SPP: u32 = 256;
+
+/// The model the fast methods render with.
+pub const FAST_MODEL: ModelKind = ModelKind::McTable;
+
+/// One run scored against the truth.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct TruthRun {
+    /// The case's name, scene, medium and light.
+    pub case: String,
+    pub scene: &'static str,
+    pub medium: &'static str,
+    pub light: &'static str,
+    /// `sss` (the peers', `mitsuba` and `cycles`, come later).
+    pub renderer: &'static str,
+    /// The method (`exact`, `volpath`, ...).
+    pub method: &'static str,
+    /// The BSSRDF model (empty for `volpath`, which uses none).
+    pub model: &'static str,
+    /// The swept parameter and its value (empty and 0 for a single run).
+    pub param: &'static str,
+    pub value: f64,
+    /// Threads it ran with.
+    pub threads: usize,
+    /// Total and shading seconds.
+    pub seconds: f64,
+    pub shading: f64,
+    /// Its figures against the truth.
+    pub score: Score,
+    /// For a model rendered by `pathtrace`: its relative RMSE with its own noise removed too,
+    /// the model's floor against the truth (None for other runs).
+    pub floor: Option<f64>,
+    /// Warnings the render gave (caps that bound).
+    pub warnings: usize,
+}
+
+/// What a case's runs leave behind besides their rows: the image of every model under
+/// `exact`, for the pictures.
+pub(crate) struct CaseRuns {
+    pub runs: Vec<TruthRun>,
+    /// (model name, its `exact` image).
+    pub model_images: Vec<(&'static str, Vec<Rgb>)>,
+    /// Method–model pairs that cannot render the case, and why.
+    pub unsupported: Vec<String>,
+}
+
+/// Runs everything of `case` against `truth`.
+pub(crate) fn run_case(
+    ctx: &Context<'_>,
+    case: &Case,
+    plan: &Plan,
+    truth: &Truth,
+) -> Result<CaseRuns, Error> {
+    let cfg = ctx.config;
+    let threads = rayon::current_num_threads();
+    let mut out = CaseRuns {
+        runs: Vec::new(),
+        model_images: Vec::new(),
+        unsupported: Vec::new(),
+    };
+    let scene_for = |model: ModelKind| {
+        case.scene(model, plan.shrink, &cfg.mesh_dirs)
+            .map_err(|e| Error(format!("truth {}: {e}", case.name())))
+    };
+    let row = |method: &'static str,
+               model: &'static str,
+               param: &'static str,
+               value: f64,
+               r: &RenderOutput| TruthRun {
+        case: case.name(),
+        scene: case.scene,
+        medium: case.medium.name,
+        light: case.lighting.name(),
+        renderer: "sss",
+        method,
+        model,
+        param,
+        value,
+        threads,
+        seconds: r.seconds_total(),
+        shading: r
+            .stages
+            .iter()
+            .filter(|s| s.name == "shading")
+            .map(|s| s.seconds)
+            .sum(),
+        score: score(&r.subsurface, truth),
+        floor: None,
+        warnings: r.warnings.len(),
+    };
+    let settings = |seed: u64| RenderSettings {
+        seed,
+        ..RenderSettings::default()
+    };
+    // Every model under `exact`, at the default comparison's reference spacing and at most
+    // [`EXACT_SAMPLES`] irradiance samples per object.
+    let exact = Exact {
+        irradiance: IrradianceSettings {
+            spacing_mfp: reference_spacing(cfg.quick),
+            max_samples: EXACT_SAMPLES,
+            ..IrradianceSettings::default()
+        },
+    };
+    for model in ModelKind::ALL {
+        let scene = scene_for(model)?;
+        let r = render(&scene, &exact, &settings(cfg.seed), &NoProgress)
+            .map_err(|e| Error(format!("truth {}: exact with {model}: {e}", case.name())))?;
+        (ctx.log)(&format!(
+            "truth {}: exact with {model}: {:.1} s",
+            case.name(),
+            r.seconds_total()
+        ));
+        out.runs.push(row("exact", model.name(), "", 0.0, &r));
+        out.model_images.push((model.name(), r.subsurface));
+    }
+    // Every model under `pathtrace` too: it converges to the integral `exact`'s sum
+    // discretises, so where `exact`'s samples are coarse (the capped head) it is the model's
+    // image; its own noise is removed from its floor.
+    for model in ModelKind::ALL {
+        let scene = scene_for(model)?;
+        let method = PathTrace {
+            spp: PATHTRACE_SPP,
+            ..PathTrace::default()
+        };
+        let r = render(&scene, &method, &settings(cfg.seed), &NoProgress).map_err(|e| {
+            Error(format!(
+                "truth {}: pathtrace with {model}: {e}",
+                case.name()
+            ))
+        })?;
+        let se = r.std_error.clone().unwrap_or_default();
+        let mut run = row("pathtrace", model.name(), "spp", PATHTRACE_SPP as f64, &r);
+        run.floor = Some(score_without_noise(&r.subsurface, &se, truth).rel_rmse);
+        out.runs.push(run);
+    }
+    // The fast methods over their sweeps.
+    if plan.fast {
+        let scene = scene_for(FAST_MODEL)?;
+        for name in FAST {
+            let m = integrators::method(name).map_err(|e| Error(e.to_string()))?;
+            for v in (m.sweep.values)(cfg.quick) {
+                let method =
+                    integrators::build(name, &MethodOptions::new().with(m.sweep.option, v))
+                        .map_err(|e| Error(e.to_string()))?;
+                match render(&scene, method.as_ref(), &settings(cfg.seed), &NoProgress) {
+                    Ok(r) => out
+                        .runs
+                        .push(row(m.name, FAST_MODEL.name(), m.sweep.label, v, &r)),
+                    Err(sss_render::Error::Unsupported(why)) => {
+                        out.unsupported
+                            .push(format!("`{name}` on `{}`: {why}", case.name()));
+                        break;
+                    }
+                    Err(e) => {
+                        return Err(Error(format!("truth {}: {name}: {e}", case.name())));
+                    }
+                }
+            }
+        }
+    }
+    // `volpath` itself, with another seed than the reference's.
+    let scene = scene_for(FAST_MODEL)?;
+    for &spp in &plan.volpath_spp {
+        let method = VolPath {
+            spp,
+            ..VolPath::default()
+        };
+        let r = render(&scene, &method, &settings(cfg.seed + 1), &NoProgress)
+            .map_err(|e| Error(format!("truth {}: volpath: {e}", case.name())))?;
+        out.runs.push(row("volpath", "", "spp", spp as f64, &r));
+    }
+    Ok(out)
+}
