@@ -1,7 +1,7 @@
 """Renders a scene exported by sss-peers (scene.json and OBJ meshes) with Mitsuba 3.
 
 Usage: python mitsuba_render.py SCENE.json OUT_PREFIX --spp N --seed S --threads T
-       [--batches K] [--mode full|subsurface] [--integrator volpathmis] [--rr-depth D]
+       [--batches K] [--mode full|subsurface] [--integrator auto|NAME] [--rr-depth D]
 
 Renders K independent images (seeds S, S + 1, ...) of N samples per pixel each and writes
 OUT_PREFIX.f32 (K x height x width x 3 little-endian float32, rows from the top, linear RGB,
@@ -19,7 +19,12 @@ The scene is built as the sss renderer sees it (the conventions are in docs/peer
 - quad lights: one-sided `rectangle` area emitters with a `null` BSDF: like sss's quads they
   emit but block nothing (a ray goes on through them, to the environment say); environment
   lights: a `constant` emitter; diffuse objects: `diffuse` with their albedo;
-- a pinhole `perspective` camera with fov_axis = "y" and a `box` pixel filter.
+- a pinhole `perspective` camera with fov_axis = "y" and a `box` pixel filter;
+- the integrator (`--integrator auto`): `volpathmis` when some object holds a medium, else
+  `path`. Mitsuba 3.9's `volpathmis` over-counts the environment seen through a `null`
+  surface from a diffuse vertex (emitter sampling and BSDF sampling disagree on the MIS
+  weight there): a grey Lambertian sphere under a constant environment with a null quad
+  above came out 7 % too bright with it, right with `path` and `volpath`.
 """
 
 import argparse
@@ -40,7 +45,7 @@ def main():
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--batches", type=int, default=1)
     ap.add_argument("--mode", choices=["full", "subsurface"], default="full")
-    ap.add_argument("--integrator", default="volpathmis")
+    ap.add_argument("--integrator", default="auto")
     ap.add_argument("--rr-depth", type=int, default=5)
     args = ap.parse_args()
 
@@ -77,9 +82,13 @@ def build(desc, base, args, opaque):
     """The Mitsuba scene dictionary of `desc`; `opaque` makes every medium opaque black."""
     from mitsuba import ScalarTransform4f as T
     cam = desc["camera"]
+    integrator = args.integrator
+    if integrator == "auto":
+        media = any(o["material"]["type"] == "medium" for o in desc["objects"])
+        integrator = "volpathmis" if media else "path"
     scene = {
         "type": "scene",
-        "integrator": {"type": args.integrator, "max_depth": -1, "rr_depth": args.rr_depth},
+        "integrator": {"type": integrator, "max_depth": -1, "rr_depth": args.rr_depth},
         "sensor": {
             "type": "perspective",
             "fov_axis": "y",

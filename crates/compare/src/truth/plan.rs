@@ -189,7 +189,7 @@ pub(crate) fn plan(quick: bool) -> Plan {
         ],
         shrink: 1,
         reference_noise: 0.04,
-        reference_spp: (16, 16384),
+        reference_spp: (16, 65536),
         volpath_spp: vec![1, 4, 16, 64, 256],
         fast: true,
         peer_spp: vec![16, 64, 256, 1024],
