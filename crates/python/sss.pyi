@@ -194,11 +194,15 @@ def render(
     max_memory: int | str | None = None,
     mesh_dirs: Sequence[str | os.PathLike[str]] | None = None,
     progress: ProgressCallback | None = None,
+    resolution: tuple[int, int] | None = None,
+    pixel_samples: int | None = None,
     **options: str | int | float | bool,
 ) -> RenderResult:
     """Render `scene` (a path, a name from `BUILTIN_SCENES`, or TOML text holding a line
     break) with `method` (one of `METHODS`) as `sss render` does; `options` are the method's
-    options (`spp=16`, `kernel="svd3"`, `uniform_taps=True`).
+    options (`spp=16`, `kernel="svd3"`, `uniform_taps=True`). `resolution=(width, height)`
+    and `pixel_samples=n` override the scene's camera, as `--resolution` and
+    `--pixel-samples` do.
 
     Returns the layers (`total`, `subsurface`, `std_error` for stochastic methods, the
     method's own) as float32 (H, W, 3), `coverage` (H, W), `stats`, `stages` (seconds),
@@ -220,6 +224,9 @@ def diff(
     reference: F32 | F64 | str | os.PathLike[str],
     *,
     layer: str = "subsurface",
+    reference_layer: str | None = None,
     eps: float = 0.05,
 ) -> DiffResult:
-    """The figures of `sss diff`: images (H, W, 3) or EXR paths (their `layer`)."""
+    """The figures of `sss diff`: images (H, W, 3) or EXR paths (their `layer`; the
+    reference's `reference_layer` when given, `"beauty"` for another renderer's plain
+    R,G,B)."""

@@ -8,14 +8,17 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use sss_bssrdf::Rgb;
-use sss_cli::commands::render::load_scene;
+use sss_cli::commands::render::{load_options, load_scene, with_mesh_hint};
 use sss_render::Error;
 use sss_render::image::read_exr;
 use sss_render::integrators::{self, MethodOptions};
 use sss_render::metrics::{error_figures, mean_ratio_rgb};
-use sss_render::scene::{LoadOptions, Scene, load_str};
+use sss_render::scene::{Scene, load_str};
 use sss_render::{RenderSettings, render as render_scene};
 use std::path::PathBuf;
+
+/// How a Python caller adds a mesh directory, for the error of a missing mesh.
+const MESH_DIR_HINT: &str = "render(..., mesh_dirs=[...])";
 
 /// Loads `scene`: TOML text (a str holding a line break), a path (str or os.PathLike) or the
 /// name of a built-in scene, as `sss render SCENE` resolves it.
@@ -23,17 +26,14 @@ fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene
     if let Ok(s) = scene.cast::<PyString>() {
         let text = s.to_cow()?;
         if text.contains('\n') {
-            let mut opts = LoadOptions::from_env();
-            let mut dirs = mesh_dirs.to_vec();
-            dirs.append(&mut opts.mesh_dirs);
-            opts.mesh_dirs = dirs;
+            let opts = load_options(mesh_dirs);
             let cwd = std::env::current_dir().ok();
             return guard(|| {
                 load_str(&text, "scene.toml", cwd.as_deref(), &opts)
-                    .map_err(|e| to_py(Error::Scene(e)))
+                    .map_err(|e| to_py(Error::Scene(with_mesh_hint(e, MESH_DIR_HINT))))
             });
         }
-        return guard(|| load_scene(&text, mesh_dirs).map_err(to_py));
+        return guard(|| load_scene(&text, mesh_dirs, MESH_DIR_HINT).map_err(to_py));
     }
     let path: PathBuf = scene.extract().map_err(|_| {
         PyTypeError::new_err(
@@ -41,7 +41,7 @@ fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene
         )
     })?;
     let name = path.to_string_lossy().into_owned();
-    guard(|| load_scene(&name, mesh_dirs).map_err(to_py))
+    guard(|| load_scene(&name, mesh_dirs, MESH_DIR_HINT).map_err(to_py))
 }
 
 /// Method options from Python keyword arguments: `spp=4` is `--spp 4`, `uniform_taps=True`
@@ -64,18 +64,20 @@ fn method_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<MethodOptions
 }
 
 /// render(scene, method="exact", *, seed=1, threads=None, max_memory=None, mesh_dirs=None,
-/// progress=None, **options) -> dict
+/// progress=None, resolution=None, pixel_samples=None, **options) -> dict
 ///
 /// Renders `scene` (a path, a built-in scene's name, or TOML text) with `method` as
 /// `sss render` does; `options` are the method's options (`spp=16`, `kernel="svd3"`,
-/// `uniform_taps=True`). Returns a dict: the layers `total`, `subsurface`, `std_error`
+/// `uniform_taps=True`). `resolution=(width, height)` and `pixel_samples=n` override the
+/// scene's camera (`camera.resolution`, `camera.pixel_samples`), as `--resolution` and
+/// `--pixel-samples` do. Returns a dict: the layers `total`, `subsurface`, `std_error`
 /// (stochastic methods) and the method's own (`irradiance`, `surface`, ...) as float32
 /// (H, W, 3); `coverage` float32 (H, W); `stats` {name: value}; `stages` {name: seconds};
 /// `method`, `settings` (the method's description), `irradiance_samples`, `warnings`.
 /// Releases the GIL; `progress(done, total)` is called with shaded samples; Ctrl-C stops it
 /// (KeyboardInterrupt), and so does an exception raised by `progress`.
 #[pyfunction]
-#[pyo3(signature = (scene, method="exact", *, seed=1, threads=None, max_memory=None, mesh_dirs=None, progress=None, **options))]
+#[pyo3(signature = (scene, method="exact", *, seed=1, threads=None, max_memory=None, mesh_dirs=None, progress=None, resolution=None, pixel_samples=None, **options))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -86,8 +88,18 @@ pub fn render<'py>(
     max_memory: Option<&Bound<'py, PyAny>>,
     mesh_dirs: Option<Vec<PathBuf>>,
     progress: Option<Bound<'py, PyAny>>,
+    resolution: Option<(u32, u32)>,
+    pixel_samples: Option<u32>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if resolution.is_some_and(|(w, h)| w == 0 || h == 0) {
+        return Err(value_error(
+            "resolution must be (width, height), both at least 1",
+        ));
+    }
+    if pixel_samples == Some(0) {
+        return Err(value_error("pixel_samples must be at least 1"));
+    }
     let opts = method_options(options)?;
     let integrator = guard(|| integrators::build(method, &opts).map_err(to_py))?;
     if threads == Some(0) {
@@ -106,7 +118,14 @@ pub fn render<'py>(
             }
         },
     };
-    let scene = scene_from(scene, &mesh_dirs.unwrap_or_default())?;
+    let mut scene = scene_from(scene, &mesh_dirs.unwrap_or_default())?;
+    if let Some((w, h)) = resolution {
+        scene.camera.width = w;
+        scene.camera.height = h;
+    }
+    if let Some(n) = pixel_samples {
+        scene.camera.pixel_samples = n;
+    }
     let settings = RenderSettings {
         seed,
         max_memory,
@@ -244,19 +263,21 @@ fn diff_input(
     Ok((w as usize, h as usize, pixels))
 }
 
-/// diff(a, ref, *, layer="subsurface", eps=0.05) -> dict
+/// diff(a, ref, *, layer="subsurface", reference_layer=None, eps=0.05) -> dict
 ///
 /// The error figures of `sss diff` of image `a` against `ref`: each an array (H, W, 3) of
-/// float32 or float64, or an EXR path (then `layer` is read). Pixels where either image is
+/// float32 or float64, or an EXR path (then `layer` is read, or for `ref` `reference_layer`
+/// when given: `"beauty"` for another renderer's plain R,G,B). Pixels where either image is
 /// positive are compared. Returns {"pixels", "rmse", "rel_rmse", "frac_within_eps",
 /// "mean_ratio" (float64 (3,))}.
 #[pyfunction]
-#[pyo3(signature = (a, reference, *, layer="subsurface", eps=0.05))]
+#[pyo3(signature = (a, reference, *, layer="subsurface", reference_layer=None, eps=0.05))]
 pub fn diff<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     reference: &Bound<'py, PyAny>,
     layer: &str,
+    reference_layer: Option<&str>,
     eps: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     if !(eps.is_finite() && eps > 0.0) {
@@ -265,7 +286,7 @@ pub fn diff<'py>(
         )));
     }
     let (w, h, img) = diff_input(a, "a", layer)?;
-    let (wr, hr, reference) = diff_input(reference, "ref", layer)?;
+    let (wr, hr, reference) = diff_input(reference, "ref", reference_layer.unwrap_or(layer))?;
     if (w, h) != (wr, hr) {
         return Err(value_error(format!("a is {w}x{h} but ref is {wr}x{hr}")));
     }

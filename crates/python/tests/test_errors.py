@@ -63,6 +63,25 @@ def test_missing_scene_file_is_an_os_error_with_the_cli_message(sss_error, tmp_p
     assert str(e.value) == expected
 
 
+def test_missing_mesh_says_how_to_add_a_directory_in_python_terms(small_scene, tmp_path):
+    text = small_scene.read_text().replace('shape = "sphere"\nradius = 0.3', 'shape = "mesh"\nfile = "nowhere.obj"')
+    assert "nowhere.obj" in text
+    scene = tmp_path / "mesh.toml"
+    scene.write_text(text)
+    for given in (scene, text):
+        with pytest.raises(ValueError) as e:
+            sss.render(given, mesh_dirs=[tmp_path])
+        msg = str(e.value)
+        assert "nowhere.obj" in msg and "mesh_dirs=[...]" in msg, msg
+        assert "--mesh-dir" not in msg and "LoadOptions" not in msg, msg
+
+
+def test_unknown_scene_name_lists_the_built_in_scenes():
+    with pytest.raises(OSError) as e:
+        sss.render("bunnyy")
+    assert "bunnyy" in str(e.value) and "sphere, toad" in str(e.value), str(e.value)
+
+
 def test_bad_scene_text_and_method_are_value_errors_with_the_cli_message(sss_error, small_scene, tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text(small_scene.read_text().replace("radius = 1.0", "radius = -1.0"))

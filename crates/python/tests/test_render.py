@@ -83,6 +83,13 @@ def test_diff_equals_sss_diff(small_scene, run_sss, tmp_path):
             np.testing.assert_allclose(got["frac_within_eps"], expected["frac_within_0.1"][0], atol=5e-5)
             np.testing.assert_allclose(got["mean_ratio"], expected["mean_ratio"], atol=5e-6)
         assert expected["rmse"][0] > 0
+    # Each side its own layer: `total` of a against `subsurface` of b, as `sss diff` does.
+    expected = parse_diff(run_sss("diff", a, b, "--layer", "total", "--reference-layer", "subsurface"))
+    got = sss.diff(a, b, layer="total", reference_layer="subsurface")
+    assert got["pixels"] == expected["pixels"][0]
+    np.testing.assert_allclose(got["rmse"], expected["rmse"][0], rtol=1e-5)
+    same = sss.diff(sss.read_exr(a)["total"], sss.read_exr(b)["subsurface"])
+    np.testing.assert_allclose(got["rmse"], same["rmse"], rtol=1e-12)
 
 
 def test_diff_of_an_image_with_itself_is_zero():
@@ -188,3 +195,13 @@ def test_long_calls_release_the_gil():
         during = [x for x in ticks if start < x < end]
         # About one tick per millisecond when the thread can run; demand a tenth of that.
         assert len(during) > 100 * (end - start), (len(during), end - start)
+
+
+def test_resolution_and_pixel_samples_override_the_camera(small_scene):
+    out = sss.render(small_scene, "pathtrace", spp=1, resolution=(6, 4), pixel_samples=2)
+    assert out["total"].shape == (4, 6, 3)
+    assert out["coverage"].shape == (4, 6)
+    with pytest.raises(ValueError, match="resolution"):
+        sss.render(small_scene, resolution=(0, 4))
+    with pytest.raises(ValueError, match="pixel_samples"):
+        sss.render(small_scene, pixel_samples=0)

@@ -65,7 +65,51 @@ pub fn write_exr(
     height: u32,
     layers: &[(&str, &[Rgb])],
 ) -> Result<(), crate::Error> {
+    write_exr_with(path, width, height, layers, &[])
+}
+
+/// [`write_exr`] with text attributes in the header, `(name, value)` each: how the image was
+/// made, say (`sss render` writes `sss/method`, `sss/seed`, ...; [`read_exr_attributes`]
+/// gives them back). Values are written as UTF-8 bytes (OpenEXR's own library reads a text
+/// attribute as a `std::string` of bytes). A name must be 1 to 31 printable ASCII characters,
+/// not one of the standard attributes'; otherwise an error, nothing written.
+pub fn write_exr_with(
+    path: &Path,
+    width: u32,
+    height: u32,
+    layers: &[(&str, &[Rgb])],
+    attributes: &[(&str, String)],
+) -> Result<(), crate::Error> {
     use exr::prelude::*;
+    const STANDARD: [&str; 12] = [
+        "channels",
+        "compression",
+        "dataWindow",
+        "displayWindow",
+        "lineOrder",
+        "pixelAspectRatio",
+        "screenWindowCenter",
+        "screenWindowWidth",
+        "name",
+        "type",
+        "chunkCount",
+        "tiles",
+    ];
+    let utf8 = |t: &str| -> Text { Text::from_slice_unchecked(t.as_bytes()) };
+    for (i, (name, _)) in attributes.iter().enumerate() {
+        let bad = name.is_empty()
+            || name.len() > 31
+            || !name.bytes().all(|b| b.is_ascii_graphic())
+            || STANDARD.contains(name)
+            || attributes[..i].iter().any(|(n, _)| n == name);
+        if bad {
+            return Err(crate::Error::Input(format!(
+                "{}: cannot write header attribute `{name}`: names must be distinct, 1 to 31 \
+                 printable ASCII characters and not a standard attribute's",
+                path.display()
+            )));
+        }
+    }
     let (w, h) = (width as usize, height as usize);
     if layers.is_empty() || layers.iter().any(|(_, d)| d.len() != w * h) {
         return Err(crate::Error::Input(format!(
@@ -106,9 +150,15 @@ pub fn write_exr(
             ));
         }
     }
+    let mut header = LayerAttributes::named(Text::new_or_panic(layers[0].0));
+    for (name, value) in attributes {
+        header
+            .other
+            .insert(utf8(name), AttributeValue::Text(utf8(value)));
+    }
     let layer = Layer::new(
         size,
-        LayerAttributes::named(Text::new_or_panic(layers[0].0)),
+        header,
         // Blocks in increasing order: the parallel encoder otherwise writes them in the order
         // its threads finish, so the same image would give different files.
         Encoding {
@@ -128,6 +178,33 @@ pub fn write_exr(
         },
         |e| io_err(path, "writing", e),
     )
+}
+
+/// The text attributes of an OpenEXR file's first header that are not standard ones, `(name,
+/// value)` sorted by name, the values read as UTF-8 (invalid bytes as U+FFFD): what
+/// [`write_exr_with`] wrote, or another renderer's.
+pub fn read_exr_attributes(path: &Path) -> Result<Vec<(String, String)>, crate::Error> {
+    use exr::meta::attribute::AttributeValue;
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_err(path, "reading", e))?;
+    let Some(header) = meta.headers.first() else {
+        return Ok(Vec::new());
+    };
+    let mut out: Vec<(String, String)> = header
+        .own_attributes
+        .other
+        .iter()
+        .chain(header.shared_attributes.other.iter())
+        .filter_map(|(k, v)| match v {
+            AttributeValue::Text(t) => Some((
+                k.to_string(),
+                String::from_utf8_lossy(t.as_slice()).into_owned(),
+            )),
+            _ => None,
+        })
+        .collect();
+    out.sort();
+    Ok(out)
 }
 
 /// Named RGB layers of an image: (layer name, pixels).

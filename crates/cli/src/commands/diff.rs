@@ -19,9 +19,14 @@ pub struct DiffArgs {
     pub image: PathBuf,
     /// The reference (OpenEXR from `sss render`).
     pub reference: PathBuf,
-    /// Which layer to compare.
+    /// Which layer to compare (of both files, unless `--reference-layer` names the
+    /// reference's).
     #[arg(long, default_value = "subsurface")]
     pub layer: String,
+    /// The reference's layer, when it differs from `--layer`: `beauty` for the plain R,G,B of
+    /// another renderer's EXR, say.
+    #[arg(long, value_name = "NAME")]
+    pub reference_layer: Option<String>,
     /// False-colour error map (PNG) of the relative error per pixel.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
@@ -52,23 +57,29 @@ pub fn run(args: &DiffArgs) -> Result<String, Error> {
             args.reference.display()
         )));
     }
-    let pick = |layers: &[(String, Vec<Rgb>)], path: &Path| -> Result<Vec<Rgb>, Error> {
+    let pick = |layers: &[(String, Vec<Rgb>)],
+                path: &Path,
+                layer: &str,
+                flag: &str|
+     -> Result<Vec<Rgb>, Error> {
         layers
             .iter()
-            .find(|(n, _)| *n == args.layer)
+            .find(|(n, _)| n == layer)
             .map(|(_, d)| d.clone())
             .ok_or_else(|| {
                 let names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
                 Error::Input(format!(
-                    "{}: no layer `{}` (it has: {})",
+                    "{}: no layer `{layer}` (it has: {}; choose with {flag})",
                     path.display(),
-                    args.layer,
                     names.join(", ")
                 ))
             })
     };
-    let img = pick(&a, &args.image)?;
-    let reference = pick(&b, &args.reference)?;
+    let img = pick(&a, &args.image, &args.layer, "--layer")?;
+    let reference = match &args.reference_layer {
+        Some(l) => pick(&b, &args.reference, l, "--reference-layer")?,
+        None => pick(&b, &args.reference, &args.layer, "--reference-layer")?,
+    };
     let pixels: Vec<usize> = (0..img.len())
         .filter(|&i| reference[i].iter().chain(img[i].iter()).any(|v| *v > 0.0))
         .collect();

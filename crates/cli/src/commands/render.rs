@@ -6,7 +6,7 @@ use crate::method_flags::{AllMethods, MethodFlags, method_parser};
 use clap::Args;
 use sss_bssrdf::Rgb;
 use sss_render::Error;
-use sss_render::image::{auto_exposure, write_exr, write_png};
+use sss_render::image::{auto_exposure, write_exr, write_exr_with, write_png};
 use sss_render::integrators::{self, Integrator, MethodOptions};
 use sss_render::scene::{self, LoadOptions, Scene};
 use sss_render::{RenderOutput, RenderSettings, render};
@@ -44,7 +44,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DIR")]
     pub mesh_dir: Vec<PathBuf>,
     /// Linear OpenEXR output, one part: layer `total` as the channels R,G,B, then
-    /// `subsurface.R,G,B` and, for stochastic methods, `std_error.R,G,B`.
+    /// `subsurface.R,G,B`, for stochastic methods `std_error.R,G,B`, and the method's own
+    /// layers (`dual-tree`: `sampling_rate`, `pixel_clusters`; `manylight`: `triplets`; ...).
     #[arg(long, value_name = "FILE.exr")]
     pub out: Option<PathBuf>,
     /// Tone-mapped sRGB PNG of the total.
@@ -55,6 +56,25 @@ pub struct RenderArgs {
     /// for `sss filter`.
     #[arg(long, value_name = "FILE.exr")]
     pub gbuffer: Option<PathBuf>,
+    /// The image size, overriding the scene's `camera.resolution` (the field of view stays
+    /// vertical: a wider image sees more on the sides).
+    #[arg(long, value_name = "WIDTHxHEIGHT", value_parser = parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
+    /// Camera samples per pixel, overriding the scene's `camera.pixel_samples`.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub pixel_samples: Option<u32>,
+}
+
+/// `640x480` (or `640X480`): both at least 1.
+pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("`{s}` is not WIDTHxHEIGHT with both at least 1 (640x480, say)");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if w == 0 || h == 0 {
+        return Err(bad());
+    }
+    Ok((w, h))
 }
 
 /// The integrator `--method` and its flags describe. Flags of other methods are ignored with a
@@ -73,16 +93,50 @@ pub fn integrator(method: &str, given: &MethodOptions) -> Result<Box<dyn Integra
 }
 
 /// Loads a scene file, or a built-in scene when `name` is not a file but names one.
-pub fn load_scene(name: &str, mesh_dirs: &[PathBuf]) -> Result<Scene, Error> {
-    let mut opts = LoadOptions::from_env();
-    let mut dirs = mesh_dirs.to_vec();
-    dirs.append(&mut opts.mesh_dirs);
-    opts.mesh_dirs = dirs;
+/// `mesh_dir_hint` says how this caller's user adds a mesh directory (`--mesh-dir DIR` in the
+/// CLI, `mesh_dirs=[...]` in Python): a missing mesh's error names it ([`with_mesh_hint`]),
+/// and a name that is neither a file nor a built-in scene lists the built-in scenes.
+pub fn load_scene(name: &str, mesh_dirs: &[PathBuf], mesh_dir_hint: &str) -> Result<Scene, Error> {
+    let opts = load_options(mesh_dirs);
     let path = Path::new(name);
-    if !path.exists() && scene::BUILTIN_SCENES.iter().any(|(n, _)| *n == name) {
-        return Ok(scene::builtin(name, &opts)?);
+    let builtin = scene::BUILTIN_SCENES.iter().any(|(n, _)| *n == name);
+    let loaded = if !path.exists() && builtin {
+        scene::builtin(name, &opts)
+    } else {
+        scene::load(path, &opts)
+    };
+    loaded.map_err(|mut e| {
+        if e.kind == scene::SceneErrorKind::Io && !path.exists() && !builtin {
+            let names: Vec<&str> = scene::BUILTIN_SCENES.iter().map(|(n, _)| *n).collect();
+            e.message = format!(
+                "{}; nor is it a built-in scene ({})",
+                e.message,
+                names.join(", ")
+            );
+        }
+        Error::Scene(with_mesh_hint(e, mesh_dir_hint))
+    })
+}
+
+/// The mesh directories `dirs` (searched first), then those of `SSS_MESH_DIR`.
+pub fn load_options(dirs: &[PathBuf]) -> LoadOptions {
+    let mut opts = LoadOptions::from_env();
+    let mut all = dirs.to_vec();
+    all.append(&mut opts.mesh_dirs);
+    opts.mesh_dirs = all;
+    opts
+}
+
+/// A scene error with, when a mesh file was not found, how to add a directory: `hint` (the
+/// caller's own way, `--mesh-dir DIR` say) or the `SSS_MESH_DIR` environment variable.
+pub fn with_mesh_hint(mut e: scene::SceneError, hint: &str) -> scene::SceneError {
+    if e.kind == scene::SceneErrorKind::MeshNotFound {
+        e.message = format!(
+            "{}; add a mesh directory with {hint} or the SSS_MESH_DIR environment variable",
+            e.message
+        );
     }
-    Ok(scene::load(path, &opts)?)
+    e
 }
 
 /// Checks that `path` ends in `.ext` and that its directory is writable.
@@ -135,9 +189,22 @@ pub fn run(args: &RenderArgs) -> Result<String, Error> {
         }
         check_output(p, "exr")?;
     }
-    let scene = load_scene(&args.scene, &args.mesh_dir)?;
+    let mut scene = load_scene(&args.scene, &args.mesh_dir, "--mesh-dir DIR")?;
+    if let Some((w, h)) = args.resolution {
+        scene.camera.width = w;
+        scene.camera.height = h;
+    }
+    if let Some(n) = args.pixel_samples {
+        scene.camera.pixel_samples = n;
+    }
     for w in &scene.warnings {
         eprintln!("warning: {w}");
+    }
+    if args.out.is_none() && args.png.is_none() && args.gbuffer.is_none() {
+        eprintln!(
+            "warning: no --out FILE.exr or --png FILE.png given: the image is not kept, only \
+             the summary is printed"
+        );
     }
     let settings = RenderSettings {
         seed: args.seed,
@@ -169,7 +236,11 @@ pub fn run(args: &RenderArgs) -> Result<String, Error> {
         if let Some(se) = &out.std_error {
             layers.push(("std_error", se));
         }
-        write_exr(p, out.width, out.height, &layers)?;
+        // Then the method's own layers (dual-tree's sampling rate and pixel clusters,
+        // manylight's triplets, ...), as the help of `--out` promises.
+        layers.extend(out.layers.iter().map(|l| (l.name, l.pixels.as_slice())));
+        let made = provenance(&args.scene, &scene, method.as_ref(), &settings, &out);
+        write_exr_with(p, out.width, out.height, &layers, &made)?;
     }
     if let Some(p) = &args.png {
         write_png(
@@ -197,6 +268,42 @@ pub fn run(args: &RenderArgs) -> Result<String, Error> {
     ))
 }
 
+/// How an image was made, for the header of `--out`: the toolkit's version, the scene as
+/// given, the method with its settings, the models of the translucent materials, the seed,
+/// the camera samples per pixel, and the render's seconds and statistics.
+fn provenance(
+    given: &str,
+    scene: &Scene,
+    method: &dyn Integrator,
+    s: &RenderSettings,
+    out: &RenderOutput,
+) -> Vec<(&'static str, String)> {
+    let models: Vec<String> = scene
+        .materials
+        .iter()
+        .filter_map(|m| match &m.kind {
+            scene::MaterialKind::Translucent(t) => Some(format!("{}: {}", m.name, t.model)),
+            scene::MaterialKind::Diffuse { .. } => None,
+        })
+        .collect();
+    let stats: Vec<String> = out
+        .stats
+        .iter()
+        .map(|st| format!("{} {}", st.name, st.value))
+        .collect();
+    vec![
+        ("sss/version", env!("CARGO_PKG_VERSION").to_string()),
+        ("sss/scene", given.to_string()),
+        ("sss/method", method.name().to_string()),
+        ("sss/settings", method.describe()),
+        ("sss/models", models.join("; ")),
+        ("sss/seed", s.seed.to_string()),
+        ("sss/pixel_samples", scene.camera.pixel_samples.to_string()),
+        ("sss/seconds", format!("{:.3}", out.seconds_total())),
+        ("sss/stats", stats.join("; ")),
+    ]
+}
+
 fn summary(
     scene: &Scene,
     method: &dyn Integrator,
@@ -220,23 +327,98 @@ fn summary(
         let _ = writeln!(text, "irradiance samples: {}", out.irradiance_samples);
     }
     for st in &out.stats {
-        let _ = writeln!(text, "{}: {}", st.name.replace('_', " "), st.value);
+        let _ = writeln!(
+            text,
+            "{}: {}",
+            st.name.replace('_', " "),
+            significant(st.value)
+        );
     }
     let _ = writeln!(
         text,
         "translucent pixels: {}",
         out.translucent_pixels().len()
     );
-    let _ = writeln!(text, "stage        seconds");
+    // The stage names' column as wide as the longest (`irradiance_tree`, say).
+    let w = out
+        .stages
+        .iter()
+        .map(|st| st.name.len())
+        .chain(["stage".len(), "write".len()])
+        .max()
+        .unwrap_or(5);
+    let _ = writeln!(text, "{:<w$} seconds", "stage");
     for st in &out.stages {
-        let _ = writeln!(text, "{:<12} {:.4}", st.name, st.seconds);
+        let _ = writeln!(text, "{:<w$} {:.4}", st.name, st.seconds);
     }
-    let _ = writeln!(text, "{:<12} {:.4}", "write", write_seconds);
+    let _ = writeln!(text, "{:<w$} {:.4}", "write", write_seconds);
     let _ = writeln!(
         text,
-        "{:<12} {:.4}",
+        "{:<w$} {:.4}",
         "total",
         out.seconds_total() + write_seconds
     );
     text
+}
+
+/// A statistic as read: a whole number as it is, anything else to 4 significant digits
+/// (`0.0001` rather than `0.00009999999999998899`), in scientific notation outside
+/// 10⁻⁴ ..= 10⁹.
+pub fn significant(v: f64) -> String {
+    if !v.is_finite() {
+        return v.to_string();
+    }
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        return format!("{v:.0}");
+    }
+    let rounded: f64 = format!("{v:.3e}").parse().unwrap_or(v);
+    let mag = rounded.abs().log10().floor();
+    if (-4.0..=9.0).contains(&mag) {
+        let decimals = (3.0 - mag).max(0.0) as usize;
+        let fixed = format!("{rounded:.decimals$}");
+        if fixed.contains('.') {
+            fixed
+                .trim_end_matches('0')
+                .trim_end_matches('.')
+                .to_string()
+        } else {
+            fixed
+        }
+    } else {
+        format!("{rounded:.3e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{parse_resolution, significant};
+
+    #[test]
+    fn statistics_read_as_figures() {
+        for (v, want) in [
+            (0.000_099_999_999_999_988_99, "0.0001"),
+            (271.502_788_104_089_23, "271.5"),
+            (12.0, "12"),
+            (1_234_567.0, "1234567"),
+            (0.5, "0.5"),
+            (-4.56789, "-4.568"),
+            (123_456.7, "123500"),
+            (1.5e-7, "1.500e-7"),
+            (2.5e-12, "2.500e-12"),
+            (1e16, "1.000e16"),
+            (0.0, "0"),
+            (f64::NAN, "NaN"),
+        ] {
+            assert_eq!(significant(v), want, "{v}");
+        }
+    }
+
+    #[test]
+    fn resolutions_parse_as_width_by_height() {
+        assert_eq!(parse_resolution("640x480"), Ok((640, 480)));
+        assert_eq!(parse_resolution("8X6"), Ok((8, 6)));
+        for bad in ["640", "0x4", "4x0", "ax4", "4x-1", "x", ""] {
+            assert!(parse_resolution(bad).is_err(), "{bad}");
+        }
+    }
 }

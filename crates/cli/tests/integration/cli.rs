@@ -3,6 +3,7 @@
 
 use sss_bssrdf::{Medium, ModelKind, make_model, presets::PRESETS};
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 use crate::common;
 use crate::common::{sss, stderr, stdout};
@@ -603,6 +604,91 @@ fn render_writes_exr_and_png_and_reports_stages() {
     ]);
     assert!(same.contains("rmse 0.000000e0"), "{same}");
     assert!(std::fs::metadata(&err_png).unwrap().len() > 100);
+
+    // Another renderer's EXR: its plain R,G,B (`beauty`) against our `subsurface`, each side
+    // naming its layer; the same figures as against our own file.
+    let (rw, rh, ref_layers) = sss_render::image::read_exr(&reference).unwrap();
+    let sub = &ref_layers
+        .iter()
+        .find(|(n, _)| n == "subsurface")
+        .unwrap()
+        .1;
+    let theirs = dir.join("theirs.exr");
+    sss_render::image::write_exr(&theirs, rw, rh, &[("beauty", sub)]).unwrap();
+    let (a, t) = (exr.to_str().unwrap(), theirs.to_str().unwrap());
+    let o = sss(&["diff", a, t]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.contains("no layer `subsurface`") && err.contains("--reference-layer"),
+        "{err}"
+    );
+    let peer = ok(&["diff", a, t, "--reference-layer", "beauty"]);
+    assert_eq!(peer, diff, "the same figures against the same pixels");
+}
+
+/// `--out` holds the method's own layers too, as its help says: dual-tree's sampling rate
+/// (positive where the sphere is seen) and pixel clusters.
+#[test]
+fn render_out_holds_the_methods_layers() {
+    let dir = tmp_dir("render-layers");
+    let scene = tiny_scene(&dir);
+    let exr = dir.join("dt.exr");
+    ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--method",
+        "dual-tree",
+        "--out",
+        exr.to_str().unwrap(),
+    ]);
+    let (_, _, layers) = sss_render::image::read_exr(&exr).unwrap();
+    let mut names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["pixel_clusters", "sampling_rate", "subsurface", "total"],
+        "{names:?}"
+    );
+    let rate = &layers.iter().find(|(n, _)| n == "sampling_rate").unwrap().1;
+    assert!(rate.iter().any(|p| p[0] > 0.0), "no sampling rate anywhere");
+    assert!(rate.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+
+    // The header says how the image was made.
+    let made = sss_render::image::read_exr_attributes(&exr).unwrap();
+    let get = |k: &str| {
+        made.iter()
+            .find(|(n, _)| n == k)
+            .map(|(_, v)| v.clone())
+            .unwrap_or_else(|| panic!("no {k} in {made:?}"))
+    };
+    assert_eq!(get("sss/method"), "dual-tree");
+    assert_eq!(get("sss/seed"), "1");
+    assert_eq!(get("sss/scene"), scene.to_str().unwrap());
+    assert_eq!(get("sss/version"), env!("CARGO_PKG_VERSION"));
+    assert!(get("sss/settings").contains("ρ = 0.75"), "{made:?}");
+    assert!(get("sss/models").contains(':'), "{made:?}");
+    assert!(get("sss/seconds").parse::<f64>().unwrap() > 0.0);
+
+    // The camera's resolution and samples overridden from the command line.
+    let small = dir.join("small.exr");
+    ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--resolution",
+        "6x4",
+        "--pixel-samples",
+        "3",
+        "--out",
+        small.to_str().unwrap(),
+    ]);
+    let (w, h, _) = sss_render::image::read_exr(&small).unwrap();
+    assert_eq!((w, h), (6, 4));
+    let made = sss_render::image::read_exr_attributes(&small).unwrap();
+    assert!(
+        made.contains(&("sss/pixel_samples".to_string(), "3".to_string())),
+        "{made:?}"
+    );
 }
 
 #[test]
@@ -628,6 +714,12 @@ fn render_bad_input_fails_with_one_line() {
         ),
         (vec!["render", scene, "--spacing", "-1"], "--spacing"),
         (vec!["render", scene, "--threads", "0"], "--threads"),
+        (vec!["render", scene, "--resolution", "0x5"], "--resolution"),
+        (vec!["render", scene, "--resolution", "640"], "WIDTHxHEIGHT"),
+        (
+            vec!["render", scene, "--pixel-samples", "0"],
+            "--pixel-samples",
+        ),
         (vec!["render", scene, "--method", "magic"], "magic"),
         (vec!["diff", "nope-a.exr", "nope-b.exr"], "nope-a.exr"),
     ];
@@ -641,6 +733,54 @@ fn render_bad_input_fails_with_one_line() {
         assert!(stdout(&o).is_empty(), "{args:?}");
     }
     assert!(!missing_dir.exists());
+}
+
+/// What a new user mistypes gets an error that says what to do: a scene name that is neither
+/// a file nor a built-in scene lists the built-in scenes; a missing mesh names `--mesh-dir`
+/// (not a Rust API) and each directory searched once.
+#[test]
+fn missing_scenes_and_meshes_say_what_to_do() {
+    let o = sss(&["render", "bunnyy"]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    for w in [
+        "bunnyy",
+        "built-in scene",
+        "sphere, toad, picnic, backlit, slab, bunny",
+    ] {
+        assert!(err.contains(w), "`{w}` not in {err}");
+    }
+
+    let dir = tmp_dir("missing-mesh");
+    let scene = dir.join("mesh.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\nposition = [0, 0, 4]\ntarget = [0, 0, 0]\nfov = 35\nresolution = [8, 8]\n\n\
+         [[lights]]\ntype = \"point\"\nposition = [0, 4, 4]\nintensity = 10\n\n\
+         [materials.skin]\ntype = \"translucent\"\npreset = \"skin1\"\nunits_per_mm = 0.1\n\n\
+         [[objects]]\nmaterial = \"skin\"\nshape = \"mesh\"\nfile = \"missing.obj\"\n",
+    )
+    .unwrap();
+    let d = dir.to_str().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_sss"))
+        .args(["render", scene.to_str().unwrap(), "--mesh-dir", d])
+        .env_remove("SSS_MESH_DIR")
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    for w in ["missing.obj", "--mesh-dir DIR", "SSS_MESH_DIR"] {
+        assert!(err.contains(w), "`{w}` not in {err}");
+    }
+    assert!(!err.contains("LoadOptions"), "{err}");
+    // The scene's directory and the mesh directory are the same: listed once.
+    assert_eq!(
+        err.matches(d).count(),
+        2,
+        "the scene file and one directory: {err}"
+    );
 }
 
 /// `sss kernel` JSON: per-channel weight sums equal the model's total diffuse reflectance (or 1
@@ -1004,9 +1144,12 @@ fn filter_reads_the_gbuffer_and_reproduces_the_pass() {
         "max ratio {max_ratio} vs F_t(1) {ft1}"
     );
     // Bad input: a file without the layers, and --gbuffer without the separable method.
+    // (The separable render's `--out` holds them too, as its own layers.)
+    let plain = dir.join("plain.exr");
+    sss_render::image::write_exr(&plain, 2, 2, &[("total", &[[0.5; 3]; 4])]).unwrap();
     let o = sss(&[
         "filter",
-        sep.to_str().unwrap(),
+        plain.to_str().unwrap(),
         "--preset",
         "skin1",
         "--units-per-mm",
@@ -1057,7 +1200,10 @@ fn render_warns_when_a_cap_binds_and_for_foreign_flags() {
     let o = sss(&["render", path, "--max-samples", "300", "--spp", "4"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);
-    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("warning: ")).collect();
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("warning: ") && !l.contains("not kept"))
+        .collect();
     assert_eq!(lines.len(), 2, "{err}");
     assert!(
         lines[0].contains("--spp") && lines[0].contains("exact"),
@@ -1072,9 +1218,16 @@ fn render_warns_when_a_cap_binds_and_for_foreign_flags() {
         "{}",
         stdout(&o)
     );
+    // Without an output file: the one warning says the image is not kept.
     let o = sss(&["render", path]);
     assert!(o.status.success());
-    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    let err = stderr(&o);
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("warning: ")).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(
+        lines[0].contains("--out") && lines[0].contains("not kept"),
+        "{err}"
+    );
 
     // Over the memory budget: one error line, exit 2, no output file.
     let out = dir.join("x.exr");

@@ -4,7 +4,8 @@
 
 use sss_bssrdf::Rgb;
 use sss_render::image::{
-    UNNAMED_LAYER, check_exr_budget, exr_bytes, read_exr, read_exr_within, write_exr,
+    UNNAMED_LAYER, check_exr_budget, exr_bytes, read_exr, read_exr_attributes, read_exr_within,
+    write_exr, write_exr_with,
 };
 use std::path::{Path, PathBuf};
 
@@ -143,6 +144,48 @@ fn three_layers_round_trip_by_name_with_the_first_layer_first() {
         std::fs::read(&path).unwrap(),
         std::fs::read(&again).unwrap()
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Header attributes round trip (sorted by name, UTF-8 kept); a file without
+/// them has none; a bad or standard name is refused with nothing written.
+#[test]
+fn header_attributes_round_trip() {
+    let dir = temp_dir("attributes");
+    let path = dir.join("made.exr");
+    let px = ramp(4, 0);
+    let attrs = [
+        ("sss/seed", "7".to_string()),
+        ("sss/method", "pathtrace".to_string()),
+        ("sss/scene", "scènes/π.toml".to_string()),
+    ];
+    write_exr_with(&path, 2, 2, &[("total", &px)], &attrs).unwrap();
+    let got = read_exr_attributes(&path).unwrap();
+    let want: Vec<(String, String)> = [
+        ("sss/method", "pathtrace"),
+        ("sss/scene", "scènes/π.toml"),
+        ("sss/seed", "7"),
+    ]
+    .iter()
+    .map(|(k, v)| (k.to_string(), v.to_string()))
+    .collect();
+    assert_eq!(got, want);
+    assert_eq!(read_exr(&path).unwrap().2[0].1, px);
+    let plain = dir.join("plain.exr");
+    write_exr(&plain, 2, 2, &[("total", &px)]).unwrap();
+    assert!(read_exr_attributes(&plain).unwrap().is_empty());
+    for bad in [
+        "",
+        "compression",
+        "has space",
+        "a-name-of-more-than-31-characters",
+    ] {
+        let out = dir.join("bad.exr");
+        let e =
+            write_exr_with(&out, 2, 2, &[("total", &px)], &[(bad, "x".to_string())]).unwrap_err();
+        assert!(e.to_string().contains("bad.exr"), "{e}");
+        assert!(!out.exists(), "{bad}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

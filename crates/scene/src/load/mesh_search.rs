@@ -31,18 +31,21 @@ impl Ctx<'_> {
         let searched = if p.is_absolute() {
             "it does not exist".to_string()
         } else if dirs.is_empty() {
-            "no directories to search (set SSS_MESH_DIR or LoadOptions::mesh_dirs)".to_string()
+            "no mesh directory to search".to_string()
         } else {
-            let shown: Vec<String> = dirs
-                .iter()
-                .map(|d| {
-                    if d.as_os_str().is_empty() {
-                        ".".to_string()
-                    } else {
-                        d.display().to_string()
-                    }
-                })
-                .collect();
+            // Each directory once, in the order searched (the scene's own directory and a
+            // mesh directory are often the same).
+            let mut shown: Vec<String> = Vec::new();
+            for d in &dirs {
+                let d = if d.as_os_str().is_empty() {
+                    ".".to_string()
+                } else {
+                    d.display().to_string()
+                };
+                if !shown.contains(&d) {
+                    shown.push(d);
+                }
+            }
             format!("searched: {}", shown.join(", "))
         };
         Err(SceneError {

@@ -28,7 +28,7 @@ fn invalid(file: &str, line: Option<usize>, message: String) -> SceneError {
 /// Checks the `v`, `vn`, `vt` and `f` lines of an OBJ text: coordinates must parse as finite
 /// single-precision numbers, face indices must be non-zero integers within the counts of
 /// their kind (positive indices against the whole file, negative ones against the lines so
-/// far). Errors carry the 1-based line number. Returns whether every face corner names a
+/// far), and a face must have three corners or more. Errors carry the 1-based line number. Returns whether every face corner names a
 /// normal (`f v//vn` or `f v/vt/vn`), so that `vn` can be used as given.
 fn check_lines(file: &str, text: &str) -> Result<bool, SceneError> {
     // Totals first: positive face indices may refer to any element of the file.
@@ -82,6 +82,20 @@ fn check_lines(file: &str, text: &str) -> Result<bool, SceneError> {
             }
             "vt" => seen[1] += 1,
             "f" => {
+                // A face needs three corners: fewer is a cut or garbled line (a file
+                // truncated mid-face, say), never a degenerate triangle to drop.
+                let count = line.split_whitespace().count() - 1;
+                if count < 3 {
+                    return Err(invalid(
+                        file,
+                        Some(lineno),
+                        format!(
+                            "face with {count} corner{} (3 or more needed): is the file cut \
+                             short?",
+                            if count == 1 { "" } else { "s" }
+                        ),
+                    ));
+                }
                 for tok in tokens {
                     corners += 1;
                     if tok.split('/').nth(2).is_some_and(|n| !n.is_empty()) {

@@ -197,7 +197,7 @@ fn obj_degenerate_triangles_are_dropped_and_counted() {
 #[test]
 fn obj_errors_name_the_file_and_line() {
     let dir = temp_dir("obj-errors");
-    let cases: [(&str, &str, usize, &[&str]); 10] = [
+    let cases: [(&str, &str, usize, &[&str]); 12] = [
         (
             "nan.obj",
             "v 0 0 0\nv 1 0 0\n# c\nv 0 nan 0\nf 1 2 3\n",
@@ -251,6 +251,20 @@ fn obj_errors_name_the_file_and_line() {
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//-1 2//-1 3//-2\n",
             5,
             &["normal index -2", "out of range", "1 before this line"],
+        ),
+        (
+            // A file cut mid-face (the bunny's `f 1787 1413`): an error, not a dropped
+            // degenerate triangle.
+            "cut.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 3 2",
+            5,
+            &["face with 2 corners", "cut short"],
+        ),
+        (
+            "bare-f.obj",
+            "v 0 0 0\nf\nv 1 0 0\n",
+            2,
+            &["face with 0 corners"],
         ),
         (
             "short.obj",
