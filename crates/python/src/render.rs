@@ -222,6 +222,7 @@ fn diff_input(
     obj: &Bound<'_, PyAny>,
     what: &str,
     layer: &str,
+    param: &str,
 ) -> PyResult<(usize, usize, Vec<Rgb>)> {
     let rgb_pixels =
         |v: Vec<f64>| -> Vec<Rgb> { v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect() };
@@ -255,7 +256,7 @@ fn diff_input(
         .ok_or_else(|| {
             let names: Vec<&str> = layers.iter().map(|(n, _)| n.as_str()).collect();
             value_error(format!(
-                "{}: no layer `{layer}` (it has: {})",
+                "{}: no layer `{layer}` (it has: {}; choose with {param}=)",
                 path.display(),
                 names.join(", ")
             ))
@@ -285,8 +286,13 @@ pub fn diff<'py>(
             "eps must be a finite number > 0, got {eps}"
         )));
     }
-    let (w, h, img) = diff_input(a, "a", layer)?;
-    let (wr, hr, reference) = diff_input(reference, "ref", reference_layer.unwrap_or(layer))?;
+    let (w, h, img) = diff_input(a, "a", layer, "layer")?;
+    let (wr, hr, reference) = diff_input(
+        reference,
+        "ref",
+        reference_layer.unwrap_or(layer),
+        "reference_layer",
+    )?;
     if (w, h) != (wr, hr) {
         return Err(value_error(format!("a is {w}x{h} but ref is {wr}x{hr}")));
     }

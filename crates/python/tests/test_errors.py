@@ -111,10 +111,14 @@ def test_exr_errors(tmp_path, sss_error, small_scene, run_sss):
         sss.read_exr(notexr)
     a = tmp_path / "a.exr"
     run_sss("render", small_scene, "--out", a)
+    # The message `sss` prints, in Python's terms: `layer=` where it says `--layer`.
     expected = sss_error("diff", a, a, "--layer", "nope")
+    assert "choose with --layer" in expected
     with pytest.raises(ValueError) as e:
         sss.diff(a, a, layer="nope")
-    assert str(e.value) == expected
+    assert str(e.value) == expected.replace("--layer", "layer=")
+    with pytest.raises(ValueError, match="choose with reference_layer="):
+        sss.diff(a, a, reference_layer="nope")
 
 
 def test_kernel_and_filter_arguments(sss_error):

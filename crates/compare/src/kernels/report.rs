@@ -39,7 +39,12 @@ pub(super) fn csv(rows: &[Row], (fw, fh): (usize, usize)) -> Csv {
 
 /// The report section: the kernels' table on the test image, and the world-space table
 /// `world` ([`world_space`]).
-pub(super) fn section(rows: &[Row], world: &[Vec<String>], (fw, fh): (usize, usize)) -> Section {
+pub(super) fn section(
+    rows: &[Row],
+    world: &[Vec<String>],
+    (fw, fh): (usize, usize),
+    cells: usize,
+) -> Section {
     let table_rows: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
@@ -58,7 +63,7 @@ pub(super) fn section(rows: &[Row], world: &[Vec<String>], (fw, fh): (usize, usi
     let body = format!(
         "Frame {fw}x{fh} at {MM_PER_PIXEL} mm per pixel; error on a {TEST_SIDE}² image with a \
          diagonal shadow edge and a bright spot against the exact 2D screen-space convolution \
-         with the full 127² kernel (better dipole), jitter 0.1. Images in `kernels/`, spectra in \
+         with the full {cells}² kernel (better dipole), jitter 0.1. Images in `kernels/`, spectra in \
          `singular_values.png`, error against time in `kernel_error_vs_time.png`, every number \
          in `kernels.csv`. Error against the world-space reference: the `separable` rows of \
          `results.csv`.\n\n{}",

@@ -28,18 +28,19 @@ pub(super) struct MaterialRuns {
 }
 
 /// Every kernel method for material `name` (its better-dipole `model`): built, filtered over
-/// `test` against the exact 2D convolution, and timed on `big`. Writes the shadow-edge
+/// `test` against the exact 2D convolution with the full kernel on `spec`'s grid, and timed
+/// on `big`. Writes the shadow-edge
 /// pictures of the pre-integrated kernel with importance-sampled taps into `dir`.
 pub(super) fn material_runs(
     name: &str,
     model: &dyn Bssrdf,
+    spec: &Kernel2dSpec,
     test: &Frame,
     big: &Frame,
     all_threads: usize,
     dir: &Path,
 ) -> Result<MaterialRuns, Error> {
-    let k2 =
-        Kernel2d::from_model(model, &Kernel2dSpec::default()).map_err(|e| Error(e.to_string()))?;
+    let k2 = Kernel2d::from_model(model, spec).map_err(|e| Error(e.to_string()))?;
     let svd = svd::decompose(&k2).map_err(|e| Error(e.to_string()))?;
     let spectrum = svd.spectrum(0).to_vec();
     let opts = FilterOptions::default();
