@@ -49,6 +49,21 @@ radius = 10.0
 subdivisions = 5
 "#;
 
+/// The pixels (row-major indices of a `w` × `h` image) whose 3 × 3 neighbourhood is fully
+/// covered by geometry: where both renderers' pixels mean the same thing.
+fn inside_silhouette(coverage: &[f32], w: usize, h: usize) -> Vec<usize> {
+    (0..w * h)
+        .filter(|&i| {
+            let (x, y) = (i % w, i / w);
+            x > 0
+                && y > 0
+                && x + 1 < w
+                && y + 1 < h
+                && (0..9).all(|k| coverage[(y + k / 3 - 1) * w + x + k % 3 - 1] == 1.0)
+        })
+        .collect()
+}
+
 /// The interpreter with Mitsuba, or None (the test skips) when there is none and CI did not
 /// ask for it.
 fn peers_python() -> Option<std::path::PathBuf> {
@@ -99,16 +114,7 @@ fn volpath_equals_mitsuba_within_both_images_noise() {
 
     // Pixels whose 3 × 3 neighbourhood is fully covered.
     let (w, h) = (ours.width as usize, ours.height as usize);
-    let inside: Vec<usize> = (0..w * h)
-        .filter(|&i| {
-            let (x, y) = (i % w, i / w);
-            x > 0
-                && y > 0
-                && x + 1 < w
-                && y + 1 < h
-                && (0..9).all(|k| ours.coverage[(y + k / 3 - 1) * w + x + k % 3 - 1] == 1.0)
-        })
-        .collect();
+    let inside = inside_silhouette(&ours.coverage, w, h);
     assert!(inside.len() > 300, "{} pixels inside", inside.len());
 
     let (mut z2, mut n) = (0.0, 0);
@@ -192,17 +198,7 @@ fn opaque_radiometry_matches_mitsuba() {
         &NoProgress,
     )
     .unwrap();
-    let on = |i: usize| mask.coverage[i] == 1.0;
-    let inside: Vec<usize> = (0..w * h)
-        .filter(|&i| {
-            let (x, y) = (i % w, i / w);
-            x > 0
-                && y > 0
-                && x + 1 < w
-                && y + 1 < h
-                && (0..9).all(|k| on((y + k / 3 - 1) * w + x + k % 3 - 1))
-        })
-        .collect();
+    let inside = inside_silhouette(&mask.coverage, w, h);
     assert!(inside.len() > 300);
     let ratio: Vec<f64> = (0..3)
         .map(|c| {
