@@ -2,7 +2,8 @@
 separable kernels, screen-space filter, renders and image metrics on numpy arrays.
 
 Profiles are float64, images float32 (H, W, 3) row-major from the top-left; lengths in mm.
-Errors keep the one-line message of the `sss` tool: ValueError for bad input, OSError for
+Errors keep the one-line message of the `sss` tool in Python's terms (the keyword
+`max_samples` where the tool names `--max-samples`): ValueError for bad input, OSError for
 files, TypeError for an argument of the wrong type or dtype.
 """
 
@@ -24,7 +25,10 @@ BUILTIN_SCENES: list[str]
 
 F64 = npt.NDArray[np.float64]
 F32 = npt.NDArray[np.float32]
-RGB = Sequence[float] | npt.ArrayLike
+#: Three numbers (R, G, B), or one for all three channels (as in a scene file).
+RGB = float | Sequence[float] | npt.ArrayLike
+#: A float64 array (N,), or a sequence of numbers (a list, a tuple, a range).
+F64Like = F64 | Sequence[float]
 #: progress(done, total), called on the calling thread about every 0.1 s and once at the end;
 #: raising from it stops the call and the exception propagates.
 ProgressCallback = Callable[[int, int], object]
@@ -71,22 +75,22 @@ class Model:
     @overload
     def rd(self, r: float) -> F64: ...
     @overload
-    def rd(self, r: F64) -> F64: ...
-    def rd(self, r: float | F64) -> F64:
-        """R_d(r) in 1/mm² at radii r (mm, float64 (N,), finite, >= 0): shape (N, 3);
-        a float r gives shape (3,)."""
+    def rd(self, r: F64Like) -> F64: ...
+    def rd(self, r: float | F64Like) -> F64:
+        """R_d(r) in 1/mm² at radii r (mm, float64 (N,) or a list, finite, >= 0): shape
+        (N, 3); a float r gives shape (3,)."""
     @overload
     def sample_r(self, u: float, channel: int) -> float: ...
     @overload
-    def sample_r(self, u: F64, channel: int) -> F64: ...
-    def sample_r(self, u: float | F64, channel: int) -> float | F64:
+    def sample_r(self, u: F64Like, channel: int) -> F64: ...
+    def sample_r(self, u: float | F64Like, channel: int) -> float | F64:
         """Radii (mm) with density proportional to 2πr R_d(r) of `channel` (0, 1, 2), from
         uniform u in [0, 1)."""
     @overload
     def pdf_r(self, r: float, channel: int) -> float: ...
     @overload
-    def pdf_r(self, r: F64, channel: int) -> F64: ...
-    def pdf_r(self, r: float | F64, channel: int) -> float | F64:
+    def pdf_r(self, r: F64Like, channel: int) -> F64: ...
+    def pdf_r(self, r: float | F64Like, channel: int) -> float | F64:
         """The density per mm of radius with which `sample_r` returns r."""
 
 class Preset(TypedDict):
@@ -200,9 +204,10 @@ def render(
 ) -> RenderResult:
     """Render `scene` (a path, a name from `BUILTIN_SCENES`, or TOML text holding a line
     break) with `method` (one of `METHODS`) as `sss render` does; `options` are the method's
-    options (`spp=16`, `kernel="svd3"`, `uniform_taps=True`). `resolution=(width, height)`
-    and `pixel_samples=n` override the scene's camera, as `--resolution` and
-    `--pixel-samples` do.
+    options (`spp=16`, `kernel="svd3"`, `uniform_taps=True`); an option of another method
+    is ignored with a UserWarning (as the command line does), one of no method is a
+    TypeError. `resolution=(width, height)` and `pixel_samples=n` override the scene's
+    camera, as `--resolution` and `--pixel-samples` do.
 
     Returns the layers (`total`, `subsurface`, `std_error` for stochastic methods, the
     method's own) as float32 (H, W, 3), `coverage` (H, W), `stats`, `stages` (seconds),

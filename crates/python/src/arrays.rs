@@ -86,13 +86,19 @@ pub fn read<T: Element + Copy>(
     Ok((values, shape))
 }
 
-/// A float64 argument that is a Python number or a 1-D array: its values, and whether it was
-/// a scalar (so results can be returned as scalars too).
+/// A float64 argument that is a Python number, a sequence of numbers (a list, a tuple, a
+/// range) or a 1-D float64 array: its values, and whether it was a scalar (so results can be
+/// returned as scalars too), as numpy functions take whatever `np.asarray` takes.
 pub fn read_f64s(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<f64>, bool)> {
-    if obj.cast::<PyUntypedArray>().is_err()
-        && let Ok(v) = obj.extract::<f64>()
-    {
-        return Ok((vec![v], true));
+    if obj.cast::<PyUntypedArray>().is_err() {
+        if let Ok(v) = obj.extract::<f64>() {
+            return Ok((vec![v], true));
+        }
+        if !obj.is_instance_of::<pyo3::types::PyString>()
+            && let Ok(v) = obj.extract::<Vec<f64>>()
+        {
+            return Ok((v, false));
+        }
     }
     let (v, _) = read::<f64>(obj, name, "float64", &[Axis::Any("N")])?;
     Ok((v, false))
@@ -161,11 +167,17 @@ pub fn rgb<'py>(py: Python<'py>, v: Rgb) -> PyResult<Bound<'py, PyAny>> {
     new_array(py, v.to_vec(), &[3])
 }
 
-/// Argument `name` as an RGB triple: any sequence of three numbers (a list, a tuple, an array).
+/// Argument `name` as an RGB triple: any sequence of three numbers (a list, a tuple, an
+/// array), or one number for all three channels (as a scene file's coefficients).
 pub fn extract_rgb(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Rgb> {
+    if obj.cast::<PyUntypedArray>().is_err()
+        && let Ok(v) = obj.extract::<f64>()
+    {
+        return Ok([v; 3]);
+    }
     let values: Vec<f64> = obj.extract().map_err(|_| {
         PyTypeError::new_err(format!(
-            "{name} must be a sequence of three numbers (R, G, B)"
+            "{name} must be a number or a sequence of three numbers (R, G, B)"
         ))
     })?;
     <[f64; 3]>::try_from(values.as_slice()).map_err(|_| {

@@ -31,7 +31,8 @@
 //! Conventions: profiles are float64, images float32 `(H, W, 3)` row-major from the top-left;
 //! lengths in mm. Arrays of another dtype or shape are refused (`TypeError` for the type or
 //! dtype, `ValueError` for the shape) with a message naming the argument; strided arrays are
-//! copied. Errors of the Rust side keep the one-line message `sss` prints: `ValueError` for bad
+//! copied. Errors of the Rust side keep the one-line message `sss` prints, in Python's terms
+//! (the keyword `max_samples` where `sss` names `--max-samples`): `ValueError` for bad
 //! input, `OSError` for files (a subclass such as `FileNotFoundError` where the cause is known),
 //! `RuntimeError` for a non-finite model value; a panic is caught and raised as
 //! `RuntimeError`, never as PyO3's `PanicException`.

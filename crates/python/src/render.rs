@@ -2,7 +2,7 @@
 //! `read_exr()` (the EXR reader `sss diff` and `sss filter` use).
 
 use crate::arrays::{Axis, image, new_array, read};
-use crate::errors::{guard, to_py, value_error};
+use crate::errors::{guard, python_terms, to_py, value_error};
 use crate::progress::run_cancellable;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -44,6 +44,42 @@ fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene
     guard(|| load_scene(&name, mesh_dirs, MESH_DIR_HINT).map_err(to_py))
 }
 
+/// The options of `method` among those `given`, and a warning for each option given that
+/// another method takes (ignored, as the command line ignores another method's flag with a
+/// warning). An option no method takes is a `ValueError` (a misspelling, most likely) naming
+/// the options `method` does take.
+fn options_of(method: &str, given: &MethodOptions) -> PyResult<(MethodOptions, Vec<String>)> {
+    let m = guard(|| integrators::method(method).map_err(to_py))?;
+    let keyword = |name: &str| name.replace('-', "_");
+    let mut options = MethodOptions::new();
+    let mut ignored = Vec::new();
+    for name in given.names() {
+        if m.options.iter().any(|o| o.name == name) {
+            options.set(name, given.value(name).unwrap_or_default());
+        } else if integrators::METHODS
+            .iter()
+            .any(|other| other.options.iter().any(|o| o.name == name))
+        {
+            ignored.push(format!(
+                "{} is not an option of method {method}; ignored",
+                keyword(name)
+            ));
+        } else {
+            let known: Vec<String> = m.options.iter().map(|o| keyword(o.name)).collect();
+            return Err(PyTypeError::new_err(format!(
+                "render() got an unexpected keyword argument '{}' (method {method} takes {})",
+                keyword(name),
+                if known.is_empty() {
+                    "no options".to_string()
+                } else {
+                    known.join(", ")
+                }
+            )));
+        }
+    }
+    Ok((options, ignored))
+}
+
 /// Method options from Python keyword arguments: `spp=4` is `--spp 4`, `uniform_taps=True`
 /// the switch `--uniform-taps` (False leaves it off).
 fn method_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<MethodOptions> {
@@ -68,9 +104,10 @@ fn method_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<MethodOptions
 ///
 /// Renders `scene` (a path, a built-in scene's name, or TOML text) with `method` as
 /// `sss render` does; `options` are the method's options (`spp=16`, `kernel="svd3"`,
-/// `uniform_taps=True`). `resolution=(width, height)` and `pixel_samples=n` override the
-/// scene's camera (`camera.resolution`, `camera.pixel_samples`), as `--resolution` and
-/// `--pixel-samples` do. Returns a dict: the layers `total`, `subsurface`, `std_error`
+/// `uniform_taps=True`): one of another method is ignored with a `UserWarning` (as the
+/// command line does), one of no method is a `TypeError`. `resolution=(width, height)` and
+/// `pixel_samples=n` override the scene's camera (`camera.resolution`,
+/// `camera.pixel_samples`), as `--resolution` and `--pixel-samples` do. Returns a dict: the layers `total`, `subsurface`, `std_error`
 /// (stochastic methods) and the method's own (`irradiance`, `surface`, ...) as float32
 /// (H, W, 3); `coverage` float32 (H, W); `stats` {name: value}; `stages` {name: seconds};
 /// `method`, `settings` (the method's description), `irradiance_samples`, `warnings`.
@@ -100,7 +137,17 @@ pub fn render<'py>(
     if pixel_samples == Some(0) {
         return Err(value_error("pixel_samples must be at least 1"));
     }
-    let opts = method_options(options)?;
+    let given = method_options(options)?;
+    let (opts, ignored) = options_of(method, &given)?;
+    let warn = |msg: &str| -> PyResult<()> {
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        let text = std::ffi::CString::new(msg.replace('\0', " "))
+            .map_err(|e| value_error(e.to_string()))?;
+        PyErr::warn(py, &category, &text, 1)
+    };
+    for msg in &ignored {
+        warn(msg)?;
+    }
     let integrator = guard(|| integrators::build(method, &opts).map_err(to_py))?;
     if threads == Some(0) {
         return Err(value_error("threads must be at least 1"));
@@ -148,12 +195,6 @@ pub fn render<'py>(
             None => go(),
         }
     })?;
-    let warn = |msg: &str| -> PyResult<()> {
-        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
-        let text = std::ffi::CString::new(msg.replace('\0', " "))
-            .map_err(|e| value_error(e.to_string()))?;
-        PyErr::warn(py, &category, &text, 1)
-    };
     let d = PyDict::new(py);
     let (w, h) = (out.width, out.height);
     d.set_item("total", image(py, &out.total, w, h)?)?;
@@ -190,11 +231,12 @@ pub fn render<'py>(
         .warnings
         .iter()
         .chain(out.warnings.iter())
-        .cloned()
+        .map(|w| python_terms(w))
         .collect();
     for msg in &warnings {
         warn(msg)?;
     }
+    let warnings: Vec<String> = ignored.into_iter().chain(warnings).collect();
     d.set_item("warnings", warnings)?;
     Ok(d)
 }
@@ -294,7 +336,9 @@ pub fn diff<'py>(
         "reference_layer",
     )?;
     if (w, h) != (wr, hr) {
-        return Err(value_error(format!("a is {w}x{h} but ref is {wr}x{hr}")));
+        return Err(value_error(format!(
+            "a has shape ({h}, {w}, 3) but ref has shape ({hr}, {wr}, 3)"
+        )));
     }
     // The pixels `sss diff` compares: where either image is positive.
     let pixels: Vec<usize> = (0..img.len())

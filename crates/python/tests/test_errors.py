@@ -1,6 +1,8 @@
 """Bad input: the right exception, with the message `sss` prints; arrays of the wrong shape
 or dtype refused with a message naming the argument."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -32,14 +34,17 @@ def test_mc_table_eta_range_has_the_cli_message(sss_error):
     expected = sss_error("profile", "--model", "mc-table", "--preset", "skin1", "--eta", 2.0, "--r-max", 1, "--steps", 2)
     with pytest.raises(ValueError) as e:
         sss.Model("mc-table", preset="skin1", eta=2.0)
-    assert str(e.value) == expected
+    # In Python's terms: the keyword `eta` where `sss` says `--eta`.
+    assert expected.startswith("--eta 2 is outside"), expected
+    assert str(e.value) == expected[len("--"):]
 
 
 def test_monte_carlo_bad_request_has_the_cli_message(sss_error):
     expected = sss_error("profile", "--model", "monte-carlo", "--preset", "skin1", "--r-max", 0, "--steps", 2)
     with pytest.raises(ValueError) as e:
         sss.monte_carlo(preset="skin1", r_max=0.0, bins=2)
-    assert str(e.value) == expected
+    assert expected.startswith("--r-max 0 must be"), expected
+    assert str(e.value) == "r_max" + expected[len("--r-max"):]
 
 
 def test_unknown_model_and_medium_arguments():
@@ -94,12 +99,52 @@ def test_bad_scene_text_and_method_are_value_errors_with_the_cli_message(sss_err
     with pytest.raises(ValueError) as e:
         sss.render(small_scene, "nope")
     assert "`nope`" in str(e.value) and all(m in str(e.value) for m in sss.METHODS)
-    with pytest.raises(ValueError, match="not an option of method exact"):
-        sss.render(small_scene, "exact", spp=4)
+    # The message `sss` prints, in Python's terms: the keyword `spp` where it says `--spp`.
     expected = sss_error("render", small_scene, "--method", "pathtrace", "--spp", "x")
+    assert expected.startswith("--spp: invalid value `x`"), expected
     with pytest.raises(ValueError) as e:
         sss.render(small_scene, "pathtrace", spp="x")
-    assert str(e.value) == expected
+    assert str(e.value) == "spp" + expected[len("--spp"):]
+
+
+def test_options_of_another_method_are_ignored_with_a_warning_as_the_cli_does(small_scene, sss_bin, tmp_path):
+    # `sss render --spp 4` with exact warns and renders; so does Python, with a UserWarning.
+    exr = tmp_path / "exact.exr"
+    cli = subprocess.run([str(sss_bin), "render", str(small_scene), "--spp", "4", "--out", str(exr)],
+                         capture_output=True, text=True)
+    assert cli.returncode == 0 and "--spp is not an option of method exact; ignored" in cli.stderr, cli.stderr
+    with pytest.warns(UserWarning, match=r"^spp is not an option of method exact; ignored$"):
+        out = sss.render(small_scene, "exact", spp=4)
+    np.testing.assert_array_equal(out["total"], sss.read_exr(exr)["total"])
+    assert out["warnings"][0] == "spp is not an option of method exact; ignored"
+    # An option of no method is a misspelling: a TypeError, as for any unknown keyword,
+    # naming what the method does take.
+    with pytest.raises(TypeError) as e:
+        sss.render(small_scene, "pathtrace", sp=4)
+    msg = str(e.value)
+    assert "'sp'" in msg and "spp" in msg and "probe_energy" in msg and "--" not in msg, msg
+
+
+def test_method_messages_name_keywords_not_flags(small_scene):
+    # Every option's message in the caller's terms: the keyword (underscored), and a listed
+    # value as the keyword argument that selects it.
+    cases = [
+        ("pathtrace", {"spp": 0}, "spp must be at least 1"),
+        ("pathtrace", {"probe_energy": 2.0}, "probe_energy must lie strictly between 0 and 1"),
+        ("dual-tree-fmm", {"expansion_order": 3}, "expansion_order must be 1 or 2"),
+        ("manylight", {"max_splits": 0}, "max_splits must be in 1..=2^30"),
+        ("separable", {"taps": 5000}, "taps must lie in 1..=1025"),
+    ]
+    for method, opts, text in cases:
+        with pytest.raises(ValueError) as e:
+            sss.render(small_scene, method, **opts)
+        assert text in str(e.value) and "--" not in str(e.value), (method, str(e.value))
+    # The sphere's point light cannot be reached through a dielectric boundary: the message
+    # names the keyword argument that lights it.
+    with pytest.raises(ValueError) as e:
+        sss.render(small_scene, "volpath")
+    msg = str(e.value)
+    assert 'use boundary="lambertian"' in msg and "--" not in msg, msg
 
 
 def test_exr_errors(tmp_path, sss_error, small_scene, run_sss):
@@ -124,13 +169,14 @@ def test_exr_errors(tmp_path, sss_error, small_scene, run_sss):
 def test_kernel_and_filter_arguments(sss_error):
     m = sss.Model("better-dipole", preset="skin1")
     expected = sss_error("kernel", "--preset", "skin1", "--taps", 0)
+    assert expected == "--taps must lie in 1..=1025, got 0", expected
     with pytest.raises(ValueError) as e:
         sss.kernel(m, taps=0)
-    assert str(e.value) == expected
+    assert str(e.value) == "taps must lie in 1..=1025, got 0"
     expected = sss_error("kernel", "--preset", "skin1", "--method", "exact2d")
     with pytest.raises(ValueError) as e:
         sss.kernel(m, "exact2d")
-    assert str(e.value) == expected
+    assert str(e.value) == expected.replace("--method", "method")
     with pytest.raises(ValueError, match="unknown kernel `nope`"):
         sss.kernel(m, "nope")
     with pytest.raises(ValueError, match="unknown format"):
@@ -164,7 +210,7 @@ def test_filter_refuses_wrong_dtypes_and_shapes():
         sss.filter(irr, depth, fp, ids, "preintegrated")
     with pytest.raises(ValueError, match="units_per_mm must be positive"):
         sss.filter(irr, depth, fp, ids, "preintegrated", m, units_per_mm=0.0)
-    with pytest.raises(ValueError, match="--jitter must lie in"):
+    with pytest.raises(ValueError, match="^jitter must lie in"):
         sss.filter(irr, depth, fp, ids, "preintegrated", m, jitter=2.0)
 
 
@@ -183,12 +229,28 @@ def test_profile_arrays_refused_with_clear_messages():
     with pytest.raises(ValueError, match="channel must be 0, 1 or 2"):
         m.pdf_r(1.0, 3)
     with pytest.raises(TypeError, match="r must be a numpy array"):
-        m.rd([1.0, 2.0])
+        m.rd("1.0")
+
+
+def test_profiles_take_lists_and_coefficients_take_one_number_as_a_scene_file_does():
+    m = sss.Model("pbd", preset="skin1")
+    np.testing.assert_array_equal(m.rd([0.5, 1.0]), m.rd(np.array([0.5, 1.0])))
+    np.testing.assert_array_equal(m.rd((0.5, 1.0)), m.rd(np.array([0.5, 1.0])))
+    np.testing.assert_array_equal(m.sample_r([0.25, 0.5], 1), m.sample_r(np.array([0.25, 0.5]), 1))
+    assert m.rd([0.5, 1.0]).shape == (2, 3)
+    # sigma_s = 1.0 is [1, 1, 1], as `sigma_s = 1.0` in a scene file.
+    scalar = sss.Model("better-dipole", sigma_a=0.01, sigma_s=1.0)
+    triple = sss.Model("better-dipole", sigma_a=[0.01] * 3, sigma_s=[1.0] * 3)
+    np.testing.assert_array_equal(scalar.sigma_s, [1.0, 1.0, 1.0])
+    np.testing.assert_array_equal(scalar.rd(1.0), triple.rd(1.0))
+    with pytest.raises(TypeError, match="sigma_s must be a number or a sequence of three"):
+        sss.Model("better-dipole", sigma_a=0.01, sigma_s="x")
 
 
 def test_diff_refuses_bad_images():
     a = np.zeros((4, 4, 3), np.float32)
-    with pytest.raises(ValueError, match="a is 4x4 but ref is 5x4"):
+    # Shapes as numpy gives them: (H, W, 3).
+    with pytest.raises(ValueError, match=r"a has shape \(4, 4, 3\) but ref has shape \(4, 5, 3\)"):
         sss.diff(a, np.zeros((4, 5, 3), np.float32))
     bad = a.copy()
     bad[1, 1, 1] = np.inf

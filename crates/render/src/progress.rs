@@ -8,7 +8,10 @@ pub trait Progress: Sync {
     fn start(&self, total: u64) {
         let _ = total;
     }
-    /// `n` more units are done.
+    /// `n` more units are done, or about to be: every integrator calls it as a unit of work
+    /// (a G-buffer sample, a pixel, a tree's slice of samples) starts, so that a caller that
+    /// stops a render by unwinding from here (the Python module on Ctrl-C) starts no further
+    /// unit, whatever a unit costs.
     fn advance(&self, n: u64) {
         let _ = n;
     }

@@ -332,10 +332,10 @@ impl Integrator for DualTree {
                     task_slices(px, &mut acc)
                         .into_par_iter()
                         .for_each(|(s, slice)| {
+                            progress.advance(slice.len() as u64);
                             let mut l = Local::default();
                             dual.dual(s, 0, slice, &mut l);
                             counts.add(l.visits, l.clusters, l.samples);
-                            progress.advance(slice.len() as u64);
                         });
                 } else {
                     progress.advance(obj.ordered.len() as u64);

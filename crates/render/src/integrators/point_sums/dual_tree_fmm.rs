@@ -779,6 +779,7 @@ impl Integrator for DualTreeFmm {
                     task_slices(px, &mut acc)
                         .into_par_iter()
                         .for_each(|(s, slice)| {
+                            progress.advance(slice.len() as u64);
                             let mut t = Task {
                                 root: s,
                                 start: px.tree.nodes[s as usize].start as usize,
@@ -793,7 +794,6 @@ impl Integrator for DualTreeFmm {
                             fmm.push_down(&mut t);
                             counts.add(t.visits, t.clusters, t.samples);
                             sample_expansions.fetch_add(t.sample_expansions, Ordering::Relaxed);
-                            progress.advance(t.acc.len() as u64);
                         });
                 } else {
                     progress.advance(obj.ordered.len() as u64);

@@ -97,12 +97,11 @@ impl Integrator for Exact {
                 .samples
                 .par_iter()
                 .map(|g| {
-                    let v = match (frame.shading_of(g.object), by_object[g.object as usize]) {
+                    progress.advance(1);
+                    match (frame.shading_of(g.object), by_object[g.object as usize]) {
                         (Some(sh), Some(s)) => shade(g, sh, s),
                         _ => [0.0; 3],
-                    };
-                    progress.advance(1);
-                    v
+                    }
                 })
                 .collect()
         });

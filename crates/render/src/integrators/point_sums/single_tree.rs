@@ -150,7 +150,8 @@ impl Integrator for SingleTree {
                 .samples
                 .par_iter()
                 .map(|g| {
-                    let v = match (frame.shading_of(g.object), &trees[g.object as usize]) {
+                    progress.advance(1);
+                    match (frame.shading_of(g.object), &trees[g.object as usize]) {
                         (Some(sh), Some(t)) => {
                             let sum = single(t, g.p, self.eps, sh, &counts);
                             let mut out = [0.0; 3];
@@ -158,9 +159,7 @@ impl Integrator for SingleTree {
                             out
                         }
                         _ => [0.0; 3],
-                    };
-                    progress.advance(1);
-                    v
+                    }
                 })
                 .collect()
         });

@@ -461,9 +461,8 @@ impl ManyLight {
                 .map_init(
                     || Refinements::new(max_splits),
                     |refs, &i| {
-                        let out = shade(&estimators, self.stream, refs, i);
                         progress.advance(gb.pixel(i).len() as u64);
-                        out
+                        shade(&estimators, self.stream, refs, i)
                     },
                 )
                 .collect::<Result<Vec<PixelOut>, Error>>()

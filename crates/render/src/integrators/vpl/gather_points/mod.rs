@@ -299,6 +299,7 @@ fn estimate_pixels<E: PixelEstimator>(
             || (Scratch::default(), Vec::new(), Vec::new()),
             |(scratch, points, gathered), &i| {
                 let samples = gb.pixel(i);
+                progress.advance(samples.len() as u64);
                 let mut out = PixelOut {
                     values: vec![[0.0; 3]; samples.len()],
                     ..PixelOut::default()
@@ -407,7 +408,6 @@ fn estimate_pixels<E: PixelEstimator>(
                         }
                     }
                 }
-                progress.advance(samples.len() as u64);
                 Ok(out)
             },
         )
