@@ -182,6 +182,7 @@ class RenderResult(TypedDict, total=False):
     irradiance: F32
     surface: F32
     coverage: F32
+    alpha: F32
     stats: dict[str, float]
     stages: dict[str, float]
     method: str
@@ -210,12 +211,14 @@ def render(
     camera, as `--resolution` and `--pixel-samples` do.
 
     Returns the layers (`total`, `subsurface`, `std_error` for stochastic methods, the
-    method's own) as float32 (H, W, 3), `coverage` (H, W), `stats`, `stages` (seconds),
+    method's own) as float32 (H, W, 3), `coverage` (translucent objects) and `alpha` (any
+    object: the silhouette) (H, W), `stats`, `stages` (seconds),
     `method`, `settings`, `irradiance_samples`, `warnings`. Releases the GIL; progress counts
     shaded samples; Ctrl-C raises KeyboardInterrupt; an exception from progress stops it."""
 
 def read_exr(path: str | os.PathLike[str]) -> dict[str, F32]:
-    """Every RGB layer of an OpenEXR file by name, float32 (H, W, 3)."""
+    """Every RGB layer of an OpenEXR file by name, float32 (H, W, 3), and `alpha` float32
+    (H, W) when the file has the channel A (as `sss render --out` writes it)."""
 
 class DiffResult(TypedDict):
     pixels: int

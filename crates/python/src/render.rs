@@ -10,7 +10,7 @@ use pyo3::types::{PyDict, PyString};
 use sss_bssrdf::Rgb;
 use sss_cli::commands::render::{load_options, load_scene, with_mesh_hint};
 use sss_render::Error;
-use sss_render::image::read_exr;
+use sss_render::image::{read_exr, read_exr_alpha};
 use sss_render::integrators::{self, MethodOptions};
 use sss_render::metrics::{error_figures, mean_ratio_rgb};
 use sss_render::scene::{Scene, load_str};
@@ -109,7 +109,8 @@ fn method_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<MethodOptions
 /// `pixel_samples=n` override the scene's camera (`camera.resolution`,
 /// `camera.pixel_samples`), as `--resolution` and `--pixel-samples` do. Returns a dict: the layers `total`, `subsurface`, `std_error`
 /// (stochastic methods) and the method's own (`irradiance`, `surface`, ...) as float32
-/// (H, W, 3); `coverage` float32 (H, W); `stats` {name: value}; `stages` {name: seconds};
+/// (H, W, 3); `coverage` (translucent objects) and `alpha` (any object: the silhouette, the
+/// EXR's channel A) float32 (H, W); `stats` {name: value}; `stages` {name: seconds};
 /// `method`, `settings` (the method's description), `irradiance_samples`, `warnings`.
 /// Releases the GIL; `progress(done, total)` is called with shaded samples; Ctrl-C stops it
 /// (KeyboardInterrupt), and so does an exception raised by `progress`.
@@ -205,15 +206,13 @@ pub fn render<'py>(
     for layer in &out.layers {
         d.set_item(layer.name, image(py, &layer.pixels, w, h)?)?;
     }
-    let coverage: Vec<f32> = out
-        .coverage
-        .iter()
-        .map(|&c| if c.is_finite() { c } else { 0.0 })
-        .collect();
-    d.set_item(
-        "coverage",
-        new_array(py, coverage, &[h as usize, w as usize])?,
-    )?;
+    for (name, values) in [("coverage", &out.coverage), ("alpha", &out.alpha)] {
+        let clean: Vec<f32> = values
+            .iter()
+            .map(|&c| if c.is_finite() { c } else { 0.0 })
+            .collect();
+        d.set_item(name, new_array(py, clean, &[h as usize, w as usize])?)?;
+    }
     let stats = PyDict::new(py);
     for s in &out.stats {
         stats.set_item(s.name, s.value)?;
@@ -244,11 +243,21 @@ pub fn render<'py>(
 /// read_exr(path) -> dict[str, ndarray]
 ///
 /// Every RGB layer of an OpenEXR file (as `sss render --out/--gbuffer` and `sss filter` write
-/// them), by name, as float32 (H, W, 3). Raises OSError for a file that cannot be read.
+/// them), by name, as float32 (H, W, 3), and `alpha` float32 (H, W) when the file has the
+/// channel A (as `sss render --out` writes). Raises OSError for a file that cannot be read.
 #[pyfunction(name = "read_exr")]
 pub fn read_exr_layers<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
-    let (w, h, layers) = py.detach(|| guard(|| read_exr(&path).map_err(to_py)))?;
+    let (w, h, layers, alpha) = py.detach(|| {
+        guard(|| {
+            let (w, h, layers) = read_exr(&path).map_err(to_py)?;
+            let alpha = read_exr_alpha(&path).map_err(to_py)?;
+            Ok((w, h, layers, alpha))
+        })
+    })?;
     let d = PyDict::new(py);
+    if let Some(a) = alpha {
+        d.set_item("alpha", new_array(py, a, &[h as usize, w as usize])?)?;
+    }
     for (name, pixels) in &layers {
         // Callers that look layers up by name take the first (as `sss diff`).
         if !d.contains(name)? {

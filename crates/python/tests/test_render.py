@@ -34,6 +34,10 @@ def test_render_equals_sss_render_exr(method, opts, cli, small_scene, run_sss, t
     # The background and the opaque sphere are in the total only.
     assert np.any(out["total"] > out["subsurface"] + 1e-3)
     assert out["coverage"].shape == (18, 24) and out["coverage"].max() == 1.0
+    # The silhouette of both spheres, as the EXR's alpha channel holds it.
+    np.testing.assert_array_equal(out["alpha"], expected["alpha"])
+    assert out["alpha"].shape == (18, 24) and np.all(out["alpha"] >= out["coverage"])
+    assert out["alpha"].min() == 0.0 and np.any((out["alpha"] == 1.0) & (out["coverage"] == 0.0))
     assert "shading" in out["stages"] and all(v >= 0 for v in out["stages"].values())
 
 

@@ -65,7 +65,7 @@ pub fn write_exr(
     height: u32,
     layers: &[(&str, &[Rgb])],
 ) -> Result<(), crate::Error> {
-    write_exr_with(path, width, height, layers, &[])
+    write_exr_with(path, width, height, layers, None, &[])
 }
 
 /// [`write_exr`] with text attributes in the header, `(name, value)` each: how the image was
@@ -73,11 +73,17 @@ pub fn write_exr(
 /// gives them back). Values are written as UTF-8 bytes (OpenEXR's own library reads a text
 /// attribute as a `std::string` of bytes). A name must be 1 to 31 printable ASCII characters,
 /// not one of the standard attributes'; otherwise an error, nothing written.
+///
+/// `alpha`, when given (`width·height` values, clamped to [0, 1]), is the channel `A` beside
+/// the beauty's `R`, `G`, `B`: for `sss render`, the fraction of each pixel's camera samples
+/// that hit an object (the silhouette, as other renderers' film alpha). The colour layers are
+/// not premultiplied by it: the beauty holds the environment where rays missed.
 pub fn write_exr_with(
     path: &Path,
     width: u32,
     height: u32,
     layers: &[(&str, &[Rgb])],
+    alpha: Option<&[f32]>,
     attributes: &[(&str, String)],
 ) -> Result<(), crate::Error> {
     use exr::prelude::*;
@@ -111,7 +117,10 @@ pub fn write_exr_with(
         }
     }
     let (w, h) = (width as usize, height as usize);
-    if layers.is_empty() || layers.iter().any(|(_, d)| d.len() != w * h) {
+    if layers.is_empty()
+        || layers.iter().any(|(_, d)| d.len() != w * h)
+        || alpha.is_some_and(|a| a.len() != w * h)
+    {
         return Err(crate::Error::Input(format!(
             "{}: image layers must hold {}x{} pixels",
             path.display(),
@@ -149,6 +158,22 @@ pub fn write_exr_with(
                 FlatSamples::F32(samples),
             ));
         }
+    }
+    if let Some(a) = alpha {
+        let samples: Vec<f32> = a
+            .iter()
+            .map(|&v| {
+                if v.is_finite() {
+                    v.clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        channels.push(AnyChannel::new(
+            Text::new_or_panic("A"),
+            FlatSamples::F32(samples),
+        ));
     }
     let mut header = LayerAttributes::named(Text::new_or_panic(layers[0].0));
     for (name, value) in attributes {
@@ -305,6 +330,35 @@ pub fn check_exr_budget(paths: &[&Path], budget: u64) -> Result<(), crate::Error
 /// [`read_exr_within`] with the default budget ([`crate::budget::default_budget`]).
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Layers), crate::Error> {
     read_exr_within(path, crate::budget::default_budget())
+}
+
+/// The alpha channel of an OpenEXR file: the plain channel `A` of its first part (as
+/// [`write_exr_with`] writes beside the beauty, and other renderers' RGBA films), row-major
+/// from the top-left, non-finite values read as 0; `None` when the file has none. Refused
+/// before any pixel is read when its header needs more than the default memory budget.
+pub fn read_exr_alpha(path: &Path) -> Result<Option<Vec<f32>>, crate::Error> {
+    use exr::prelude::*;
+    check_exr_budget(&[path], crate::budget::default_budget())?;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| io_err(path, "reading", e))?;
+    let part = &image.layer_data;
+    Ok(part
+        .channel_data
+        .list
+        .iter()
+        .find(|ch| ch.name.to_string() == "A")
+        .map(|ch| {
+            ch.sample_data
+                .values_as_f32()
+                .map(|v| if v.is_finite() { v } else { 0.0 })
+                .collect()
+        }))
 }
 
 /// Reads every RGB layer of an OpenEXR file, with the image size (width, height).

@@ -54,6 +54,10 @@ pub struct RenderOutput {
     pub std_error: Option<Vec<Rgb>>,
     /// Fraction of each pixel's camera samples that landed on a translucent object.
     pub coverage: Vec<f32>,
+    /// Fraction of each pixel's camera samples that landed on any object (the film's alpha,
+    /// as other renderers write it: 1 inside silhouettes, 0 on the background, fractions on
+    /// edges).
+    pub alpha: Vec<f32>,
     /// Timings by stage, in order.
     pub stages: Vec<Stage>,
     /// The method's own statistics.
@@ -131,7 +135,7 @@ pub fn render(
         )));
     }
     let (irradiance_samples, spacing) = frame.samples_built();
-    let (subsurface, total, coverage) = assemble(&frame, &shaded.values, settings);
+    let (subsurface, total, coverage, alpha) = assemble(&frame, &shaded.values, settings);
     Ok(RenderOutput {
         method: integrator.name(),
         width: frame.gbuffer.width,
@@ -140,6 +144,7 @@ pub fn render(
         total,
         std_error: shaded.std_error,
         coverage,
+        alpha,
         stages: frame.stages(),
         stats: shaded.stats,
         irradiance_samples,
@@ -273,12 +278,13 @@ pub fn check_scene(scene: &Scene) -> Result<(), crate::Error> {
 
 /// Per pixel, from per-G-buffer-sample subsurface values: the subsurface image, the total
 /// (opaque samples shaded, the background added for camera samples that missed) and the
-/// translucent coverage. Non-finite or negative values count as 0. Timed as stage `opaque`.
+/// translucent coverage and the coverage by any object (alpha). Non-finite or negative values
+/// count as 0. Timed as stage `opaque`.
 fn assemble(
     frame: &Frame<'_>,
     subsurface: &[Rgb],
     settings: &RenderSettings,
-) -> (Vec<Rgb>, Vec<Rgb>, Vec<f32>) {
+) -> (Vec<Rgb>, Vec<Rgb>, Vec<f32>, Vec<f32>) {
     let gb = &frame.gbuffer;
     let spp = gb.samples_per_pixel as f64;
     let bg = background(&frame.scene.lights);
@@ -287,14 +293,16 @@ fn assemble(
     let mut subsurface_px = vec![[0.0; 3]; n];
     let mut total_px = vec![[0.0; 3]; n];
     let mut coverage = vec![0.0f32; n];
+    let mut alpha = vec![0.0f32; n];
     subsurface_px
         .par_iter_mut()
         .zip(total_px.par_iter_mut())
         .zip(coverage.par_iter_mut())
+        .zip(alpha.par_iter_mut())
         .enumerate()
         .with_min_len(1024)
         // One light-packet buffer per task for the opaque samples.
-        .for_each_init(Vec::new, |packets, (i, ((sss, total), cov))| {
+        .for_each_init(Vec::new, |packets, (i, (((sss, total), cov), a))| {
             let (lo, hi) = (gb.offsets[i] as usize, gb.offsets[i + 1] as usize);
             let mut covered = 0u32;
             for k in lo..hi {
@@ -319,7 +327,8 @@ fn assemble(
                 total[c] += bg[c] * misses / spp;
             }
             *cov = covered as f32 / spp as f32;
+            *a = (hi - lo) as f32 / spp as f32;
         });
     frame.record("opaque", t.elapsed().as_secs_f64());
-    (subsurface_px, total_px, coverage)
+    (subsurface_px, total_px, coverage, alpha)
 }

@@ -43,7 +43,8 @@ pub struct RenderArgs {
     /// Directory to search for meshes (repeatable; SSS_MESH_DIR is searched too).
     #[arg(long, value_name = "DIR")]
     pub mesh_dir: Vec<PathBuf>,
-    /// Linear OpenEXR output, one part: layer `total` as the channels R,G,B, then
+    /// Linear OpenEXR output, one part: layer `total` as the channels R,G,B with the alpha A
+    /// (the fraction of each pixel's camera samples that hit an object: the silhouette), then
     /// `subsurface.R,G,B`, for stochastic methods `std_error.R,G,B`, and the method's own
     /// layers (`dual-tree`: `sampling_rate`, `pixel_clusters`; `manylight`: `triplets`; ...).
     #[arg(long, value_name = "FILE.exr")]
@@ -240,7 +241,7 @@ pub fn run(args: &RenderArgs) -> Result<String, Error> {
         // manylight's triplets, ...), as the help of `--out` promises.
         layers.extend(out.layers.iter().map(|l| (l.name, l.pixels.as_slice())));
         let made = provenance(&args.scene, &scene, method.as_ref(), &settings, &out);
-        write_exr_with(p, out.width, out.height, &layers, &made)?;
+        write_exr_with(p, out.width, out.height, &layers, Some(&out.alpha), &made)?;
     }
     if let Some(p) = &args.png {
         write_png(

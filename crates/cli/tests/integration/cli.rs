@@ -654,6 +654,16 @@ fn render_out_holds_the_methods_layers() {
     assert!(rate.iter().any(|p| p[0] > 0.0), "no sampling rate anywhere");
     assert!(rate.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
 
+    // The beauty's alpha: the silhouette (1 on the sphere's centre, 0 in the corners).
+    let alpha = sss_render::image::read_exr_alpha(&exr)
+        .unwrap()
+        .expect("no alpha channel");
+    let (w, h, _) = sss_render::image::read_exr(&exr).unwrap();
+    assert_eq!(alpha.len(), (w * h) as usize);
+    assert!(alpha.iter().all(|a| (0.0..=1.0).contains(a)), "{alpha:?}");
+    assert_eq!(alpha[(h / 2 * w + w / 2) as usize], 1.0, "{alpha:?}");
+    assert_eq!(alpha[0], 0.0, "{alpha:?}");
+
     // The header says how the image was made.
     let made = sss_render::image::read_exr_attributes(&exr).unwrap();
     let get = |k: &str| {

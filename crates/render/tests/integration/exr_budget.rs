@@ -159,7 +159,7 @@ fn header_attributes_round_trip() {
         ("sss/method", "pathtrace".to_string()),
         ("sss/scene", "scènes/π.toml".to_string()),
     ];
-    write_exr_with(&path, 2, 2, &[("total", &px)], &attrs).unwrap();
+    write_exr_with(&path, 2, 2, &[("total", &px)], None, &attrs).unwrap();
     let got = read_exr_attributes(&path).unwrap();
     let want: Vec<(String, String)> = [
         ("sss/method", "pathtrace"),
@@ -181,8 +181,15 @@ fn header_attributes_round_trip() {
         "a-name-of-more-than-31-characters",
     ] {
         let out = dir.join("bad.exr");
-        let e =
-            write_exr_with(&out, 2, 2, &[("total", &px)], &[(bad, "x".to_string())]).unwrap_err();
+        let e = write_exr_with(
+            &out,
+            2,
+            2,
+            &[("total", &px)],
+            None,
+            &[(bad, "x".to_string())],
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("bad.exr"), "{e}");
         assert!(!out.exists(), "{bad}");
     }

@@ -279,3 +279,69 @@ fn irradiance_samples_cover_the_object() {
     }
     assert!(checked > 100);
 }
+
+/// The film's alpha is the silhouette: against the test rasteriser (edge functions at pixel
+/// centres, no code shared with the ray caster), 1 wherever a pixel and its eight neighbours
+/// are covered, 0 wherever none of them is, and its sum the covered area to within the
+/// silhouette's edge pixels. The translucent coverage is the alpha of the translucent object
+/// alone. Built-in `picnic` scene (translucent and opaque objects on a ground plane, sky
+/// above), 16 samples a pixel.
+#[test]
+fn alpha_is_the_silhouette_the_rasteriser_sees() {
+    use super::common::rasterizer::rasterize;
+    let mut s = super::common::scene("picnic", 80, 60);
+    s.camera.pixel_samples = 16;
+    let m = sss_render::integrators::build("separable", &Default::default()).unwrap();
+    let out = render(&s, m.as_ref(), &RenderSettings::default(), &NoProgress).unwrap();
+    let raster = rasterize(&s);
+    let (w, h) = (80usize, 60usize);
+    let hit = |x: i64, y: i64| {
+        (0..w as i64).contains(&x)
+            && (0..h as i64).contains(&y)
+            && raster.ids[y as usize * w + x as usize].is_some()
+    };
+    let (mut inside, mut outside, mut edge) = (0, 0, 0);
+    let mut covered = 0usize;
+    for y in 0..h as i64 {
+        for x in 0..w as i64 {
+            let a = out.alpha[y as usize * w + x as usize];
+            assert!((0.0..=1.0).contains(&a), "alpha {a} at ({x}, {y})");
+            let around: Vec<bool> = (-1..=1)
+                .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
+                .map(|(dx, dy)| hit(x + dx, y + dy))
+                .collect();
+            covered += hit(x, y) as usize;
+            if around.iter().all(|&b| b) {
+                assert_eq!(a, 1.0, "inside the silhouette at ({x}, {y})");
+                inside += 1;
+            } else if around.iter().all(|&b| !b) {
+                assert_eq!(a, 0.0, "outside the silhouette at ({x}, {y})");
+                outside += 1;
+            } else {
+                edge += 1;
+            }
+            let c = out.coverage[y as usize * w + x as usize];
+            assert!(
+                c <= a,
+                "translucent coverage {c} above alpha {a} at ({x}, {y})"
+            );
+        }
+    }
+    println!("{inside} inside, {outside} outside, {edge} on edges");
+    assert!(
+        inside > 300 && outside > 300,
+        "{inside} inside, {outside} outside"
+    );
+    let sum: f64 = out.alpha.iter().map(|&a| a as f64).sum();
+    // Each edge pixel's alpha is a 16-sample estimate: the sum errs by far less than the
+    // number of edge pixels (pixel-centre rasterising errs by about half of each).
+    assert!(
+        (sum - covered as f64).abs() < 0.1 * edge as f64,
+        "alpha sums to {sum}, the rasteriser covers {covered} pixels ({edge} on edges)"
+    );
+    // Opaque pixels: alpha 1, translucent coverage 0.
+    let opaque = (0..w * h)
+        .filter(|&i| out.alpha[i] == 1.0 && out.coverage[i] == 0.0)
+        .count();
+    assert!(opaque > 100, "{opaque} wholly opaque pixels");
+}
