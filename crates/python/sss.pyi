@@ -188,6 +188,9 @@ class RenderResult(TypedDict, total=False):
     method: str
     settings: str
     irradiance_samples: int
+    #: About how many more irradiance samples the parts of the objects out of the profile's
+    #: reach of every visible point would have taken (they get none).
+    irradiance_left_out: int
     warnings: list[str]
 
 def render(

@@ -111,7 +111,9 @@ fn method_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<MethodOptions
 /// (stochastic methods) and the method's own (`irradiance`, `surface`, ...) as float32
 /// (H, W, 3); `coverage` (translucent objects) and `alpha` (any object: the silhouette, the
 /// EXR's channel A) float32 (H, W); `stats` {name: value}; `stages` {name: seconds};
-/// `method`, `settings` (the method's description), `irradiance_samples`, `warnings`.
+/// `method`, `settings` (the method's description), `irradiance_samples`,
+/// `irradiance_left_out` (about how many more the parts out of the profile's reach of every
+/// visible point would have taken), `warnings`.
 /// Releases the GIL; `progress(done, total)` is called with shaded samples; Ctrl-C stops it
 /// (KeyboardInterrupt), and so does an exception raised by `progress`.
 #[pyfunction]
@@ -226,6 +228,7 @@ pub fn render<'py>(
     d.set_item("method", out.method)?;
     d.set_item("settings", integrator.describe())?;
     d.set_item("irradiance_samples", out.irradiance_samples)?;
+    d.set_item("irradiance_left_out", out.irradiance_left_out)?;
     let warnings: Vec<String> = scene
         .warnings
         .iter()

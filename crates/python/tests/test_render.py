@@ -2,6 +2,7 @@
 
 import os
 import signal
+import subprocess
 import threading
 import time
 
@@ -39,6 +40,47 @@ def test_render_equals_sss_render_exr(method, opts, cli, small_scene, run_sss, t
     assert out["alpha"].shape == (18, 24) and np.all(out["alpha"] >= out["coverage"])
     assert out["alpha"].min() == 0.0 and np.any((out["alpha"] == 1.0) & (out["coverage"] == 0.0))
     assert "shading" in out["stages"] and all(v >= 0 for v in out["stages"].values())
+
+
+#: A 1 m skin sphere seen close up: the camera sees a patch a few cm across.
+BIG_SPHERE = """
+[camera]
+position = [0.0, 0.0, 1.15]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 20.0
+resolution = [16, 12]
+
+[[lights]]
+type = "point"
+position = [0.5, 1.0, 2.0]
+intensity = 5.0
+
+[materials.skin]
+type = "translucent"
+model = "better-dipole"
+preset = "skin1"
+units_per_mm = 0.001
+
+[[objects]]
+material = "skin"
+shape = "sphere"
+radius = 1.0
+"""
+
+
+def test_irradiance_samples_only_where_seen_as_the_cli_reports(sss_bin, tmp_path):
+    scene = tmp_path / "big.toml"
+    scene.write_text(BIG_SPHERE)
+    cli = subprocess.run([str(sss_bin), "render", str(scene), "--method", "dual-tree-fmm",
+                          "--spacing", "4"], capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    line = next(l for l in cli.stdout.splitlines() if l.startswith("irradiance samples:"))
+    out = sss.render(BIG_SPHERE, "dual-tree-fmm", spacing=4)
+    assert out["irradiance_left_out"] > 100 * out["irradiance_samples"] > 0, out
+    assert line == (f"irradiance samples: {out['irradiance_samples']} (about "
+                    f"{out['irradiance_left_out']} more left out: beyond the profile's reach "
+                    "of every visible point)"), line
 
 
 def test_scene_as_text_path_or_builtin_name(small_scene, run_sss, tmp_path):

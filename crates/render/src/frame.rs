@@ -157,7 +157,14 @@ impl Frame<'_> {
             return Arc::clone(&c.samples);
         }
         let samples = Arc::new(self.timed("samples", || {
-            irradiance::compute(self.scene, &self.geom, &self.visible, settings, self.seed)
+            irradiance::compute_for(
+                self.scene,
+                &self.geom,
+                &self.visible,
+                settings,
+                self.seed,
+                &self.shaded_points(),
+            )
         }));
         for s in samples.iter().filter(|s| s.capped(settings)) {
             self.warn(cap_warning(self.scene, s, settings));
@@ -167,6 +174,36 @@ impl Frame<'_> {
             samples: Arc::clone(&samples),
         });
         samples
+    }
+
+    /// Per visible translucent object (in [`Frame::visible`]'s order), the G-buffer samples on
+    /// it, the points a method shades, and its profile's reach: where its irradiance samples
+    /// are needed ([`irradiance::compute_for`]).
+    pub fn shaded_points(&self) -> Vec<irradiance::ShadedPoints> {
+        self.visible
+            .iter()
+            .map(|&o| irradiance::ShadedPoints {
+                points: self
+                    .gbuffer
+                    .samples
+                    .iter()
+                    .filter(|g| g.object == o)
+                    .map(|g| g.p)
+                    .collect(),
+                reach: self.shading_of(o).map_or(f64::INFINITY, |sh| {
+                    irradiance::reach(sh.bssrdf(), sh.units_per_mm)
+                }),
+            })
+            .collect()
+    }
+
+    /// About how many irradiance samples the ones built so far left out as out of reach of
+    /// every shaded point ([`irradiance::ObjectSamples::left_out`], summed over objects).
+    pub fn samples_left_out(&self) -> usize {
+        let cache = self.samples.lock().unwrap_or_else(PoisonError::into_inner);
+        cache
+            .as_ref()
+            .map_or(0, |c| c.samples.iter().map(|s| s.left_out).sum())
     }
 
     /// The irradiance samples built so far (count summed over objects, and each object's

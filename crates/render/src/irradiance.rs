@@ -5,8 +5,16 @@
 //! Spacing follows the material: `spacing_mfp` times the smallest reduced mean free path
 //! 1/σ'_t over the channels (in scene units), bounded by a per-object cap on the count. Only
 //! the objects the caller lists get samples (the renderer passes the translucent objects the
-//! camera sees). For the directional dipole, whose S depends on the incident direction, each
-//! sample also keeps its incident light packets.
+//! camera sees), and with [`compute_for`] only the part of each object within the profile's
+//! reach of a point that will be shaded: a sample farther than the radius holding all but
+//! [`REACH_LEFT_OUT`] of the diffuse reflectance ([`Bssrdf::radius_for_energy`], largest over
+//! the channels) from every shaded point adds less than that fraction of what it would add
+//! beside one, so a large object seen close up is sampled where it is seen, at the spacing
+//! asked for, instead of all over at a spacing the per-object cap coarsens. For the
+//! directional dipole, whose S depends on the incident direction, each sample also keeps its
+//! incident light packets.
+//!
+//! [`Bssrdf::radius_for_energy`]: sss_bssrdf::Bssrdf::radius_for_energy
 
 use crate::geometry::{SceneGeometry, triangles_of};
 use crate::lights::{Incident, Receiver, gather};
@@ -16,6 +24,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::{ModelKind, Rgb};
 use sss_scene::Scene;
+use std::collections::HashMap;
 
 /// How densely to sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,6 +78,10 @@ pub struct ObjectSamples {
     pub incident: Vec<Incident>,
     /// Offsets into `incident` (length samples + 1), or empty.
     pub incident_offsets: Vec<u32>,
+    /// About how many samples at the spacing used were left out as out of reach of every
+    /// shaded point ([`compute_for`]): the samples' count scaled by the area left out over
+    /// the area sampled. 0 when the whole object was sampled.
+    pub left_out: usize,
 }
 
 impl ObjectSamples {
@@ -93,7 +106,12 @@ impl ObjectSamples {
     }
 }
 
-/// Places and lights the samples of each object in `objects` (all must be translucent).
+/// The fraction of a profile's diffuse reflectance beyond the reach within which
+/// [`compute_for`] samples an object.
+pub const REACH_LEFT_OUT: f64 = 1e-6;
+
+/// Places and lights the samples of each object in `objects` (all must be translucent), all
+/// over each object.
 pub fn compute(
     scene: &Scene,
     geom: &SceneGeometry,
@@ -101,9 +119,106 @@ pub fn compute(
     settings: &IrradianceSettings,
     seed: u64,
 ) -> Vec<ObjectSamples> {
+    compute_within(scene, geom, objects, settings, seed, None)
+}
+
+/// The points of one object that will be shaded, and its profile's reach ([`reach`]).
+#[derive(Clone, Debug, Default)]
+pub struct ShadedPoints {
+    /// Positions (scene units).
+    pub points: Vec<DVec3>,
+    /// The distance (scene units) beyond which a sample is left out; infinite: none is.
+    pub reach: f64,
+}
+
+/// [`compute`] for the points that will be shaded, `shaded[k]` on `objects[k]`: each object is
+/// sampled only where it lies within its profile's reach of one of them (see the [module
+/// docs](self)); [`ObjectSamples::left_out`] says about how many samples that saved.
+pub fn compute_for(
+    scene: &Scene,
+    geom: &SceneGeometry,
+    objects: &[u32],
+    settings: &IrradianceSettings,
+    seed: u64,
+    shaded: &[ShadedPoints],
+) -> Vec<ObjectSamples> {
+    compute_within(scene, geom, objects, settings, seed, Some(shaded))
+}
+
+/// The radius (scene units) holding all but [`REACH_LEFT_OUT`] of `model`'s diffuse
+/// reflectance in every channel, for a material of `units_per_mm` scene units per mm;
+/// infinite when the model gives no finite positive radius.
+pub fn reach(model: &dyn sss_bssrdf::Bssrdf, units_per_mm: f64) -> f64 {
+    let mut r: f64 = 0.0;
+    for c in 0..3 {
+        let v = model.radius_for_energy(c, 1.0 - REACH_LEFT_OUT);
+        if !(v.is_finite() && v > 0.0) {
+            return f64::INFINITY;
+        }
+        r = r.max(v);
+    }
+    let r = r * units_per_mm;
+    if r.is_finite() && r > 0.0 {
+        r
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The indices of the triangles of `tris` within `radius` of a point of `points`, taken
+/// conservatively (a triangle is kept when a point lies in its bounding box grown by
+/// `radius`), through a sparse grid of cells of side `radius` over the points.
+fn within_reach(tris: &[[DVec3; 3]], points: &[DVec3], radius: f64) -> Vec<u32> {
+    let cell = |p: DVec3| -> [i64; 3] {
+        let q = (p / radius).floor();
+        [q.x as i64, q.y as i64, q.z as i64]
+    };
+    let mut grid: HashMap<[i64; 3], Vec<DVec3>> = HashMap::new();
+    for &p in points.iter().filter(|p| p.is_finite()) {
+        grid.entry(cell(p)).or_default().push(p);
+    }
+    let finite: Vec<DVec3> = grid.values().flatten().copied().collect();
+    (0..tris.len() as u32)
+        .into_par_iter()
+        .filter(|&t| {
+            let [a, b, c] = tris[t as usize];
+            let lo = a.min(b).min(c) - DVec3::splat(radius);
+            let hi = a.max(b).max(c) + DVec3::splat(radius);
+            if !(lo.is_finite() && hi.is_finite()) {
+                return false;
+            }
+            let inside = |p: &DVec3| p.cmpge(lo).all() && p.cmple(hi).all();
+            let (cl, ch) = (cell(lo), cell(hi));
+            let cells = (0..3).fold(1u128, |n, k| n * (ch[k] - cl[k] + 1).max(0) as u128);
+            if cells > finite.len() as u128 {
+                return finite.iter().any(inside);
+            }
+            for x in cl[0]..=ch[0] {
+                for y in cl[1]..=ch[1] {
+                    for z in cl[2]..=ch[2] {
+                        if grid.get(&[x, y, z]).is_some_and(|ps| ps.iter().any(inside)) {
+                            return true;
+                        }
+                    }
+                }
+            }
+            false
+        })
+        .collect()
+}
+
+fn compute_within(
+    scene: &Scene,
+    geom: &SceneGeometry,
+    objects: &[u32],
+    settings: &IrradianceSettings,
+    seed: u64,
+    shaded: Option<&[ShadedPoints]>,
+) -> Vec<ObjectSamples> {
     objects
         .iter()
-        .filter_map(|&o| {
+        .enumerate()
+        .filter_map(|(k, &o)| {
             let mat = scene.translucent(o as usize)?;
             let medium = &mat.medium;
             let mfp_mm = (0..3)
@@ -111,19 +226,40 @@ pub fn compute(
                 .fold(f64::INFINITY, f64::min);
             let spacing = settings.spacing_mfp * mfp_mm * mat.units_per_mm;
             let mesh = geom.mesh(o);
-            let tris = triangles_of(mesh);
+            let all = triangles_of(mesh);
+            // The triangles sampled (indices into the mesh's), and the area left out.
+            let (kept, left_out_area) = match shaded.and_then(|s| s.get(k)) {
+                Some(s) if s.reach.is_finite() => {
+                    let kept = within_reach(&all, &s.points, s.reach);
+                    let area = |t: &[DVec3; 3]| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                    let total: f64 = all.iter().map(area).filter(|a| a.is_finite()).sum();
+                    let kept_area: f64 = kept
+                        .iter()
+                        .map(|&t| area(&all[t as usize]))
+                        .filter(|a| a.is_finite())
+                        .sum();
+                    (kept, (total - kept_area).max(0.0))
+                }
+                _ => ((0..all.len() as u32).collect(), 0.0),
+            };
+            let tris: Vec<[DVec3; 3]> = kept.iter().map(|&t| all[t as usize]).collect();
             let place_seed = sss_util::splitmix64(
                 seed ^ sss_util::splitmix64(Stream::Placement as u64 + o as u64),
             );
             let (points, stats) =
                 sss_hierarchy::blue_noise_on_mesh(&tris, spacing, settings.max_samples, place_seed);
+            let left_out = if left_out_area > 0.0 && stats.surface_area > 0.0 {
+                (points.len() as f64 * left_out_area / stats.surface_area).round() as usize
+            } else {
+                0
+            };
             let directional = mat.model == ModelKind::DirectionalDipole;
             let eta = medium.eta();
             let lit: Vec<(IrradianceSample, Vec<Incident>)> = points
                 .par_iter()
                 .enumerate()
                 .map(|(i, s)| {
-                    let [a, b, c] = mesh.triangles[s.triangle as usize];
+                    let [a, b, c] = mesh.triangles[kept[s.triangle as usize] as usize];
                     let (pa, pb, pc) = (
                         mesh.positions[a as usize],
                         mesh.positions[b as usize],
@@ -183,6 +319,7 @@ pub fn compute(
                 samples,
                 incident,
                 incident_offsets,
+                left_out,
             })
         })
         .collect()

@@ -64,6 +64,9 @@ pub struct RenderOutput {
     pub stats: Vec<Stat>,
     /// Irradiance samples built, summed over objects (0 when the method used none).
     pub irradiance_samples: usize,
+    /// About how many more irradiance samples the whole objects would have needed at the
+    /// spacing used: the parts out of the profile's reach of every visible point, left out.
+    pub irradiance_left_out: usize,
     /// Minimum spacing of the irradiance samples per object (object index, scene units).
     pub spacing: Vec<(u32, f64)>,
     /// Extra per-pixel layers of the method (e.g. the separable pass's screen-space inputs).
@@ -135,6 +138,7 @@ pub fn render(
         )));
     }
     let (irradiance_samples, spacing) = frame.samples_built();
+    let irradiance_left_out = frame.samples_left_out();
     let (subsurface, total, coverage, alpha) = assemble(&frame, &shaded.values, settings);
     Ok(RenderOutput {
         method: integrator.name(),
@@ -148,6 +152,7 @@ pub fn render(
         stages: frame.stages(),
         stats: shaded.stats,
         irradiance_samples,
+        irradiance_left_out,
         spacing,
         layers: shaded.layers,
         warnings: frame.warnings(),

@@ -325,7 +325,15 @@ fn summary(
     );
     let _ = writeln!(text, "{}", method.describe());
     if out.irradiance_samples > 0 {
-        let _ = writeln!(text, "irradiance samples: {}", out.irradiance_samples);
+        let _ = write!(text, "irradiance samples: {}", out.irradiance_samples);
+        if out.irradiance_left_out > 0 {
+            let _ = write!(
+                text,
+                " (about {} more left out: beyond the profile's reach of every visible point)",
+                out.irradiance_left_out
+            );
+        }
+        let _ = writeln!(text);
     }
     for st in &out.stats {
         let _ = writeln!(
