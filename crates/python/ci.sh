@@ -56,7 +56,7 @@ start=$(date +%s)
 "$venv/bin/maturin" build --release --manifest-path "$manifest" \
     --interpreter "$venv/bin/python" --out "$wheels"
 echo "wheel built in $(($(date +%s) - start)) s"
-"$venv/bin/pip" install --quiet --disable-pip-version-check "$wheels"/sss_py-*.whl
+"$venv/bin/pip" install --quiet --disable-pip-version-check "$wheels"/sss-*.whl
 
 echo "== python bindings: pytest"
 cd crates/python

@@ -29,7 +29,8 @@ F32 = npt.NDArray[np.float32]
 RGB = float | Sequence[float] | npt.ArrayLike
 #: A float64 array (N,), or a sequence of numbers (a list, a tuple, a range).
 F64Like = F64 | Sequence[float]
-#: progress(done, total), called on the calling thread about every 0.1 s and once at the end;
+#: progress(done, total), called on the calling thread about every 0.1 s and once at the end
+#: (`progress=True` draws a text bar on sys.stderr instead, in a terminal or a notebook);
 #: raising from it stops the call and the exception propagates.
 ProgressCallback = Callable[[int, int], object]
 
@@ -113,7 +114,7 @@ def monte_carlo(
     bins: int = 100,
     photons: int = 1_000_000,
     seed: int = 1,
-    progress: ProgressCallback | None = None,
+    progress: ProgressCallback | bool | None = None,
 ) -> tuple[F64, F64, F64]:
     """The Monte Carlo reference of `sss profile --model monte-carlo`: bin centres (N,),
     R_d (N, 3) and standard errors (N, 3) over `bins` linear bins of [0, r_max] mm.
@@ -201,7 +202,7 @@ def render(
     threads: int | None = None,
     max_memory: int | str | None = None,
     mesh_dirs: Sequence[str | os.PathLike[str]] | None = None,
-    progress: ProgressCallback | None = None,
+    progress: ProgressCallback | bool | None = None,
     resolution: tuple[int, int] | None = None,
     pixel_samples: int | None = None,
     **options: str | int | float | bool,
@@ -218,6 +219,25 @@ def render(
     object: the silhouette) (H, W), `stats`, `stages` (seconds),
     `method`, `settings`, `irradiance_samples`, `warnings`. Releases the GIL; progress counts
     shaded samples; Ctrl-C raises KeyboardInterrupt; an exception from progress stops it."""
+
+def write_exr(
+    path: str | os.PathLike[str],
+    layers: F32 | F64 | dict[str, F32 | F64],
+    *,
+    alpha: F32 | None = None,
+    attributes: dict[str, str] | None = None,
+) -> None:
+    """Write a linear OpenEXR file as `sss render --out` does: an image (H, W, 3) as the
+    plain R, G, B of a part named `beauty`, or a dict of images by name (the first the plain
+    R, G, B, the others NAME.R, NAME.G, NAME.B); `alpha` (H, W) as channel A; `attributes`
+    as text header attributes. Negative and non-finite values are written as 0; an error
+    leaves no partial file."""
+
+def write_png(
+    path: str | os.PathLike[str], image: F32 | F64, *, exposure: float | None = None
+) -> None:
+    """Write a linear image (H, W, 3) as an 8-bit sRGB PNG, as `sss render --png` does:
+    scaled by `exposure`, or by `sss render`'s automatic exposure when None."""
 
 def read_exr(path: str | os.PathLike[str]) -> dict[str, F32]:
     """Every RGB layer of an OpenEXR file by name, float32 (H, W, 3), and `alpha` float32

@@ -53,6 +53,7 @@
 
 pub mod arrays;
 pub mod errors;
+pub mod files;
 pub mod kernel;
 pub mod model;
 pub mod progress;
@@ -61,10 +62,13 @@ pub mod render;
 /// Subsurface scattering on numpy arrays: BSSRDF models (`Model`), their Monte Carlo reference
 /// (`monte_carlo`), the measured `presets`, separable kernels and their shader text (`kernel`),
 /// the screen-space filter on your own AOVs (`filter`), scene renders (`render`), EXR layers
-/// (`read_exr`) and the image metrics of `sss diff` (`diff`). Profiles are float64, images
+/// (`read_exr`, `write_exr`), PNG pictures (`write_png`) and the image metrics of `sss diff`
+/// (`diff`). Profiles are float64, images
 /// float32 (H, W, 3); lengths in mm.
 #[pyo3::pymodule(name = "sss")]
 pub mod sss_module {
+    #[pymodule_export]
+    use crate::files::{write_exr, write_png};
     #[pymodule_export]
     use crate::kernel::{Kernel, filter, kernel};
     #[pymodule_export]

@@ -330,7 +330,8 @@ pub fn presets(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 /// The Monte Carlo photon random walk of `sss profile --model monte-carlo`: `bins` linear bins
 /// over [0, r_max] mm, `photons` per channel. Returns the bin centres (float64 (N,)), R_d per
 /// bin and channel (float64 (N, 3), 1/mm²) and its standard errors (float64 (N, 3)). Releases
-/// the GIL; `progress(done, total)` is called with photons finished (total = 3 × photons);
+/// the GIL; `progress(done, total)` is called with photons finished (total = 3 × photons;
+/// `progress=True` draws a text bar on `sys.stderr`);
 /// Ctrl-C stops it (KeyboardInterrupt), and so does an exception raised by `progress`.
 #[pyfunction]
 #[pyo3(signature = (*, preset=None, sigma_a=None, sigma_s=None, g=None, eta=None, r_max, bins=100, photons=1_000_000, seed=1, progress=None))]
@@ -360,10 +361,14 @@ pub fn monte_carlo<'py>(
         seed,
     };
     check_budget(&req, sss_render::budget::default_budget()).map_err(to_py)?;
-    let table = run_cancellable(py, crate::progress::callback(progress)?, |monitor| {
-        monitor.set_total(req.photons.saturating_mul(3));
-        compute(&req, &|n| monitor.set_done(n))
-    })?;
+    let table = run_cancellable(
+        py,
+        crate::progress::callback(progress, "photons")?,
+        |monitor| {
+            monitor.set_total(req.photons.saturating_mul(3));
+            compute(&req, &|n| monitor.set_done(n))
+        },
+    )?;
     let r: Vec<f64> = table.rows.iter().map(|row| row.r).collect();
     let rd: Vec<Rgb> = table.rows.iter().map(|row| row.rd).collect();
     let se: Vec<Rgb> = table

@@ -71,15 +71,96 @@ impl sss_render::progress::Progress for Monitor {
     }
 }
 
-/// The `progress` argument of a long call: None, or a callable (else a `TypeError` now rather
-/// than at the first report).
-pub fn callback(progress: Option<Bound<'_, PyAny>>) -> PyResult<Option<Py<PyAny>>> {
+/// The bar `progress=True` shows: one line on `sys.stderr`, redrawn with a carriage return
+/// (as tqdm draws in a terminal and in a notebook's output cell), `label  37% 2390/6456
+/// [00:03 < 00:05]`, the remaining time `estimating` until a second has passed and 1 % is
+/// done (the command line's rule), a line break once everything is done.
+#[pyclass(name = "TextBar", module = "sss")]
+pub struct TextBar {
+    label: String,
+    start: std::time::Instant,
+    finished: std::sync::atomic::AtomicBool,
+}
+
+/// `m:ss` (or `h:mm:ss`) of `d`.
+fn clock(d: Duration) -> String {
+    let s = d.as_secs();
+    if s >= 3600 {
+        format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
+    } else {
+        format!("{:02}:{:02}", s / 60, s % 60)
+    }
+}
+
+impl TextBar {
+    /// The line for `done` of `total` after `elapsed`.
+    fn line(&self, done: u64, total: u64, elapsed: Duration) -> String {
+        let fraction = if total > 0 {
+            (done as f64 / total as f64).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let eta = if fraction > 0.0 {
+            elapsed.mul_f64((1.0 - fraction) / fraction)
+        } else {
+            Duration::ZERO
+        };
+        let eta = if elapsed < Duration::from_secs(1) || fraction < 0.01 {
+            "estimating".to_string()
+        } else {
+            clock(eta)
+        };
+        format!(
+            "{} {:3.0}% {done}/{total} [{} < {eta}]",
+            self.label,
+            100.0 * fraction,
+            clock(elapsed)
+        )
+    }
+}
+
+#[pymethods]
+impl TextBar {
+    /// TextBar(label) -> callable progress(done, total) drawing the bar on sys.stderr.
+    #[new]
+    fn new(label: String) -> Self {
+        TextBar {
+            label,
+            start: std::time::Instant::now(),
+            finished: Default::default(),
+        }
+    }
+
+    fn __call__(&self, py: Python<'_>, done: u64, total: u64) -> PyResult<()> {
+        if self.finished.load(Ordering::Relaxed) {
+            return Ok(());
+        }
+        let mut text = format!("\r{}", self.line(done, total, self.start.elapsed()));
+        if total > 0 && done >= total {
+            text.push('\n');
+            self.finished.store(true, Ordering::Relaxed);
+        }
+        let stderr = py.import("sys")?.getattr("stderr")?;
+        stderr.call_method1("write", (text,))?;
+        stderr.call_method0("flush")?;
+        Ok(())
+    }
+}
+
+/// The `progress` argument of a long call: None or False (no progress), True (a [`TextBar`]
+/// labelled `label`), or a callable (else a `TypeError` now rather than at the first report).
+pub fn callback(progress: Option<Bound<'_, PyAny>>, label: &str) -> PyResult<Option<Py<PyAny>>> {
+    let py_bool = |p: &Bound<'_, PyAny>| p.cast::<pyo3::types::PyBool>().ok().map(|b| b.is_true());
     match progress {
         None => Ok(None),
         Some(p) if p.is_none() => Ok(None),
+        Some(p) if py_bool(&p) == Some(false) => Ok(None),
+        Some(p) if py_bool(&p) == Some(true) => Ok(Some(
+            Py::new(p.py(), TextBar::new(label.to_string()))?.into_any(),
+        )),
         Some(p) if p.is_callable() => Ok(Some(p.unbind())),
         Some(p) => Err(pyo3::exceptions::PyTypeError::new_err(format!(
-            "progress must be a callable progress(done, total), got {}",
+            "progress must be True, False, None or a callable progress(done, total), got {}",
             p.get_type()
                 .name()
                 .map(|n| n.to_string())

@@ -1,7 +1,7 @@
 //! `render()` (as `sss render`, into arrays), `diff()` (the figures of `sss diff`) and
 //! `read_exr()` (the EXR reader `sss diff` and `sss filter` use).
 
-use crate::arrays::{Axis, image, new_array, read};
+use crate::arrays::{image, new_array};
 use crate::errors::{guard, python_terms, to_py, value_error};
 use crate::progress::run_cancellable;
 use pyo3::exceptions::PyTypeError;
@@ -114,8 +114,9 @@ fn method_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<MethodOptions
 /// `method`, `settings` (the method's description), `irradiance_samples`,
 /// `irradiance_left_out` (about how many more the parts out of the profile's reach of every
 /// visible point would have taken), `warnings`.
-/// Releases the GIL; `progress(done, total)` is called with shaded samples; Ctrl-C stops it
-/// (KeyboardInterrupt), and so does an exception raised by `progress`.
+/// Releases the GIL; `progress(done, total)` is called with shaded samples (`progress=True`
+/// draws a text bar on `sys.stderr`); Ctrl-C stops it (KeyboardInterrupt), and so does an
+/// exception raised by `progress`.
 #[pyfunction]
 #[pyo3(signature = (scene, method="exact", *, seed=1, threads=None, max_memory=None, mesh_dirs=None, progress=None, resolution=None, pixel_samples=None, **options))]
 #[allow(clippy::too_many_arguments)]
@@ -191,13 +192,17 @@ pub fn render<'py>(
         None => None,
     };
     let integrator_ref = integrator.as_ref();
-    let out = run_cancellable(py, crate::progress::callback(progress)?, |monitor| {
-        let go = || render_scene(&scene, integrator_ref, &settings, monitor);
-        match &pool {
-            Some(p) => p.install(go),
-            None => go(),
-        }
-    })?;
+    let out = run_cancellable(
+        py,
+        crate::progress::callback(progress, method)?,
+        |monitor| {
+            let go = || render_scene(&scene, integrator_ref, &settings, monitor);
+            match &pool {
+                Some(p) => p.install(go),
+                None => go(),
+            }
+        },
+    )?;
     let d = PyDict::new(py);
     let (w, h) = (out.width, out.height);
     d.set_item("total", image(py, &out.total, w, h)?)?;
@@ -278,24 +283,15 @@ fn diff_input(
     layer: &str,
     param: &str,
 ) -> PyResult<(usize, usize, Vec<Rgb>)> {
-    let rgb_pixels =
-        |v: Vec<f64>| -> Vec<Rgb> { v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect() };
-    let axes = [Axis::Any("H"), Axis::Any("W"), Axis::Fixed(3)];
     if obj.cast::<numpy::PyUntypedArray>().is_ok() {
-        let (v, shape) = match read::<f64>(obj, what, "float64", &axes) {
-            Ok(got) => got,
-            Err(_) => {
-                let (v, shape) = read::<f32>(obj, what, "float32", &axes)?;
-                (v.into_iter().map(f64::from).collect(), shape)
-            }
-        };
-        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        let (px, w, h) = crate::files::image_arg(obj, what)?;
+        if let Some(i) = px.iter().flatten().position(|x| !x.is_finite()) {
             return Err(value_error(format!(
                 "{what} holds a non-finite value ({}) at flat index {i}",
-                v[i]
+                px[i / 3][i % 3]
             )));
         }
-        return Ok((shape[1], shape[0], rgb_pixels(v)));
+        return Ok((w, h, px));
     }
     let path: PathBuf = obj.extract().map_err(|_| {
         PyTypeError::new_err(format!(
