@@ -91,7 +91,8 @@ def layer(arrays, name):
 def test_the_classic_api_sees_every_layer_in_one_part(files):
     header, arrays = read_old_api(files[0])
     channels = header["channels"]
-    expected = {c for l in LAYERS for c in channel_names(l)}
+    # Every layer's R, G, B and the beauty's alpha A.
+    expected = {c for l in LAYERS for c in channel_names(l)} | {"A"}
     assert set(channels) == expected, sorted(channels)
     float_type = Imath.PixelType(Imath.PixelType.FLOAT)
     for name, ch in channels.items():
@@ -131,6 +132,15 @@ def test_layers_hold_what_their_names_say(files):
     assert np.any(err > 0.0)
     # The error bars of a 2-sample estimate are not the estimate itself.
     assert not np.array_equal(err, sub)
+    # The alpha is the sphere's silhouette: 1 at the centre, 0 in the corners, positive
+    # wherever there is subsurface light, a fraction of the camera samples in [0, 1].
+    alpha = arrays["A"]
+    assert alpha[HEIGHT // 2, WIDTH // 2] == 1.0
+    for y, x in [(0, 0), (0, WIDTH - 1), (HEIGHT - 1, 0), (HEIGHT - 1, WIDTH - 1)]:
+        assert alpha[y, x] == 0.0, (y, x)
+    assert np.all((alpha >= 0.0) & (alpha <= 1.0))
+    assert np.all(alpha[sub.max(axis=-1) > 0.0] > 0.0)
+    assert 0.1 < alpha.mean() < 0.9, alpha.mean()
 
 
 def test_std_error_is_the_spread_of_the_subsurface_estimate(files):
