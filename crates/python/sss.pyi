@@ -194,8 +194,39 @@ class RenderResult(TypedDict, total=False):
     irradiance_left_out: int
     warnings: list[str]
 
+class Scene:
+    """A loaded, checked scene (`load_dict`, `load_file`), to pass to `render`."""
+    @property
+    def resolution(self) -> tuple[int, int]:
+        """The camera's (width, height)."""
+    @property
+    def objects(self) -> list[str]:
+        """The objects' names, in order."""
+    @property
+    def materials(self) -> list[str]:
+        """The materials' names, in order."""
+    @property
+    def warnings(self) -> list[str]:
+        """The loader's warnings."""
+    def to_dict(self) -> dict[str, object]:
+        """The description as a new dict (the scene file's structure; a scene file's mesh
+        paths made absolute): edit it and `load_dict` it again."""
+
+def load_dict(
+    description: dict[str, object], *, mesh_dirs: Sequence[str | os.PathLike[str]] | None = None
+) -> Scene:
+    """Load a scene described by a dict with the scene file's structure (`camera`, `lights`,
+    `materials`, `objects`; numpy arrays taken as lists, None as a missing key), with the scene
+    file's checks and messages naming the key (`objects[0].radius`). Relative mesh paths are
+    looked up in the working directory, then `mesh_dirs`, then SSS_MESH_DIR."""
+
+def load_file(
+    path: str | os.PathLike[str], *, mesh_dirs: Sequence[str | os.PathLike[str]] | None = None
+) -> Scene:
+    """Load a scene file (TOML) or a built-in scene by name, as `sss render SCENE` does."""
+
 def render(
-    scene: str | os.PathLike[str],
+    scene: Scene | dict[str, object] | str | os.PathLike[str],
     method: str = "exact",
     *,
     seed: int = 1,
@@ -207,8 +238,8 @@ def render(
     pixel_samples: int | None = None,
     **options: str | int | float | bool,
 ) -> RenderResult:
-    """Render `scene` (a path, a name from `BUILTIN_SCENES`, or TOML text holding a line
-    break) with `method` (one of `METHODS`) as `sss render` does; `options` are the method's
+    """Render `scene` (a `Scene`, a dict as `load_dict` takes, a path, a name from
+    `BUILTIN_SCENES`, or TOML text holding a line break) with `method` (one of `METHODS`) as `sss render` does; `options` are the method's
     options (`spp=16`, `kernel="svd3"`, `uniform_taps=True`); an option of another method
     is ignored with a UserWarning (as the command line does), one of no method is a
     TypeError. `resolution=(width, height)` and `pixel_samples=n` override the scene's

@@ -58,10 +58,12 @@ pub mod kernel;
 pub mod model;
 pub mod progress;
 pub mod render;
+pub mod scene;
 
 /// Subsurface scattering on numpy arrays: BSSRDF models (`Model`), their Monte Carlo reference
 /// (`monte_carlo`), the measured `presets`, separable kernels and their shader text (`kernel`),
-/// the screen-space filter on your own AOVs (`filter`), scene renders (`render`), EXR layers
+/// the screen-space filter on your own AOVs (`filter`), scenes as objects (`load_dict`,
+/// `load_file`, `Scene`), scene renders (`render`), EXR layers
 /// (`read_exr`, `write_exr`), PNG pictures (`write_png`) and the image metrics of `sss diff`
 /// (`diff`). Profiles are float64, images
 /// float32 (H, W, 3); lengths in mm.
@@ -75,6 +77,8 @@ pub mod sss_module {
     use crate::model::{Model, monte_carlo, presets};
     #[pymodule_export]
     use crate::render::{diff, read_exr_layers, render};
+    #[pymodule_export]
+    use crate::scene::{Scene, load_dict, load_file};
 
     use pyo3::prelude::*;
 

@@ -17,12 +17,18 @@ use sss_render::scene::{Scene, load_str};
 use sss_render::{RenderSettings, render as render_scene};
 use std::path::PathBuf;
 
-/// How a Python caller adds a mesh directory, for the error of a missing mesh.
-const MESH_DIR_HINT: &str = "render(..., mesh_dirs=[...])";
+use crate::scene::MESH_DIR_HINT;
 
-/// Loads `scene`: TOML text (a str holding a line break), a path (str or os.PathLike) or the
-/// name of a built-in scene, as `sss render SCENE` resolves it.
+/// Loads `scene`: a `Scene` (`load_dict`, `load_file`), a dict (as `load_dict` takes), TOML
+/// text (a str holding a line break), a path (str or os.PathLike) or the name of a built-in
+/// scene, as `sss render SCENE` resolves it.
 fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene> {
+    if let Ok(s) = scene.cast::<crate::scene::Scene>() {
+        return Ok(s.get().scene.clone());
+    }
+    if let Ok(d) = scene.cast::<PyDict>() {
+        return Ok(crate::scene::load_dict(d, Some(mesh_dirs.to_vec()))?.scene);
+    }
     if let Ok(s) = scene.cast::<PyString>() {
         let text = s.to_cow()?;
         if text.contains('\n') {
@@ -37,7 +43,8 @@ fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene
     }
     let path: PathBuf = scene.extract().map_err(|_| {
         PyTypeError::new_err(
-            "scene must be a path (str or os.PathLike), a built-in scene's name or TOML text",
+            "scene must be a Scene, a dict (as load_dict takes), a path (str or os.PathLike), a \
+             built-in scene's name or TOML text",
         )
     })?;
     let name = path.to_string_lossy().into_owned();
@@ -102,7 +109,8 @@ fn method_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<MethodOptions
 /// render(scene, method="exact", *, seed=1, threads=None, max_memory=None, mesh_dirs=None,
 /// progress=None, resolution=None, pixel_samples=None, **options) -> dict
 ///
-/// Renders `scene` (a path, a built-in scene's name, or TOML text) with `method` as
+/// Renders `scene` (a `Scene`, a dict as `load_dict` takes, a path, a built-in scene's name,
+/// or TOML text) with `method` as
 /// `sss render` does; `options` are the method's options (`spp=16`, `kernel="svd3"`,
 /// `uniform_taps=True`): one of another method is ignored with a `UserWarning` (as the
 /// command line does), one of no method is a `TypeError`. `resolution=(width, height)` and
