@@ -213,6 +213,25 @@ def build(bpy, desc, base, args):
         elif light["type"] == "environment":
             r = light["radiance"]
             bg.inputs["Color"].default_value = (r[0], r[1], r[2], 1.0)
+        elif light["type"] == "sun":
+            # Cycles' sun: strength is the irradiance on a surface facing it (W/m^2), angle
+            # its angular diameter (radians); it shines along its local -Z.
+            e = np.array(light["irradiance"], dtype=float)
+            peak = float(e.max()) if e.max() > 0 else 1.0
+            ldata = bpy.data.lights.new(f"light{i}", type="SUN")
+            ldata.color = tuple(e / peak)
+            ldata.energy = peak
+            ldata.angle = float(light["angular_diameter"])
+            lobj = bpy.data.objects.new(f"light{i}", ldata)
+            d = np.array(light["direction"], dtype=float)
+            z = -d / np.linalg.norm(d)
+            x = np.cross([0.0, 0.0, 1.0] if abs(z[2]) < 0.9 else [1.0, 0.0, 0.0], z)
+            x /= np.linalg.norm(x)
+            m = np.identity(4)
+            m[:3, 0], m[:3, 1], m[:3, 2] = x, np.cross(z, x), z
+            lobj.matrix_world = Matrix(m.tolist())
+            lobj.visible_glossy = False
+            scene.collection.objects.link(lobj)
         else:
             sys.exit(f"error: {args.scene}: light {i} is a {light['type']} light, which the "
                      "exported peers do not take")

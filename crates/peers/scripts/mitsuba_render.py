@@ -135,6 +135,10 @@ def build(desc, base, args, opaque):
                 "type": "constant",
                 "radiance": {"type": "rgb", "value": light["radiance"]},
             }
+        elif light["type"] == "sun":
+            sys.exit(f"error: {args.scene}: light {i} is a sun (a disc of finite angular "
+                     "diameter), which Mitsuba 3 has no emitter for (its `directional` is a "
+                     "delta light); render it with Cycles")
         else:
             sys.exit(f"error: {args.scene}: light {i} is a {light['type']} light, which a "
                      "path tracer cannot reach through a smooth dielectric")

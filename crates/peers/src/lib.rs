@@ -161,6 +161,12 @@ pub fn scene_json(scene: &Scene) -> Value {
                 irradiance,
             } => json!({"type": "directional", "direction": vec3(*direction),
                          "irradiance": irradiance}),
+            Light::Sun {
+                direction,
+                irradiance,
+                half_angle,
+            } => json!({"type": "sun", "direction": vec3(*direction), "irradiance": irradiance,
+                         "angular_diameter": 2.0 * half_angle}),
         })
         .collect();
     let objects: Vec<Value> = scene

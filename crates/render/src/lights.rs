@@ -33,8 +33,9 @@ pub struct Receiver {
 
 /// Gathers the direct light at receiver `at` into `out`:
 /// one packet per point or directional light that is above the surface and unblocked, and
-/// `area_samples` packets (each carrying 1/`area_samples` of the estimate) per quad or
-/// environment light. Packets with zero contribution are left out.
+/// `area_samples` packets (each carrying 1/`area_samples` of the estimate) per sun, quad or
+/// environment light (a sun's directions stratified over its disc: penumbrae). Packets with
+/// zero contribution are left out.
 pub fn gather(
     geom: &SceneGeometry,
     lights: &[Light],
@@ -81,6 +82,29 @@ pub fn gather(
                     continue;
                 }
                 push(out, wi, irradiance.map(|v| v * cos));
+            }
+            Light::Sun {
+                direction,
+                irradiance,
+                half_angle,
+            } => {
+                let Some((radiance, solid_angle)) = sun_radiance(*irradiance, *half_angle) else {
+                    continue;
+                };
+                for k in 0..m {
+                    let (u1, u2) = stratum(k, m, rng);
+                    let wi = cone_direction(-*direction, *half_angle, u1, u2);
+                    let cos = n.dot(wi);
+                    if !(cos > 0.0) || ng.dot(wi) <= 0.0 {
+                        continue;
+                    }
+                    if !unblocked(geom, p, ng, wi, f64::INFINITY) {
+                        continue;
+                    }
+                    // L cos dω / pdf with pdf = 1/Ω over the disc.
+                    let s = cos * solid_angle / m as f64;
+                    push(out, wi, radiance.map(|v| v * s));
+                }
             }
             Light::Quad {
                 corner,
@@ -165,6 +189,35 @@ pub(crate) fn quad_area_normal(edge_u: DVec3, edge_v: DVec3) -> Option<(f64, DVe
 
 /// A point of the unit square in stratum `k` of `m` equal strips along the first axis (uniform
 /// overall, with less variance than independent points).
+/// A sun's radiance L = E / (π sin² α) and its solid angle Ω = 2π(1 − cos α) = 4π sin²(α/2),
+/// for irradiance `irradiance` at normal incidence and angular radius `half_angle` = α (the
+/// integral of L cos θ over the disc seen head-on is L π sin² α). None for an angle outside
+/// (0, π/2] or a degenerate one.
+pub fn sun_radiance(irradiance: Rgb, half_angle: f64) -> Option<(Rgb, f64)> {
+    if !(half_angle > 0.0 && half_angle <= 0.5 * PI) {
+        return None;
+    }
+    let s = half_angle.sin();
+    let projected = PI * s * s;
+    let solid_angle = 4.0 * PI * (0.5 * half_angle).sin().powi(2);
+    if !(projected > 0.0 && solid_angle > 0.0) {
+        return None;
+    }
+    Some((irradiance.map(|e| e / projected), solid_angle))
+}
+
+/// A direction uniform in solid angle over the cone of half-angle `half_angle` about the unit
+/// `axis`, from uniform numbers `u1`, `u2` in [0, 1): cos θ = 1 − u1 (1 − cos α), the
+/// azimuth 2π u2 (1 − cos α written 2 sin²(α/2), exact for tiny cones).
+pub fn cone_direction(axis: DVec3, half_angle: f64, u1: f64, u2: f64) -> DVec3 {
+    let one_minus_cos = u1 * 2.0 * (0.5 * half_angle).sin().powi(2);
+    let cos_t = 1.0 - one_minus_cos;
+    let sin_t = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+    let phi = 2.0 * PI * u2;
+    let (a, b) = tangent_frame(axis);
+    (a * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + axis * cos_t).normalize_or(axis)
+}
+
 fn stratum(k: u32, m: u32, rng: &mut Pcg64Mcg) -> (f64, f64) {
     let u = ((k as f64 + rng.random::<f64>()) / m as f64).min(1.0 - f64::EPSILON / 2.0);
     (u, rng.random::<f64>())

@@ -187,6 +187,21 @@ pub fn check_scene(scene: &Scene) -> Result<(), crate::Error> {
                 ((direction.length() - 1.0).abs() > UNIT_TOLERANCE)
                     .then_some("the direction is not a unit vector"),
             ),
+            Light::Sun {
+                direction,
+                irradiance,
+                half_angle,
+            } => (
+                irradiance,
+                vec![*direction],
+                if (direction.length() - 1.0).abs() > UNIT_TOLERANCE {
+                    Some("the direction is not a unit vector")
+                } else if !(*half_angle > 0.0 && *half_angle <= 0.5 * std::f64::consts::PI) {
+                    Some("the half angle is not in (0, π/2]")
+                } else {
+                    None
+                },
+            ),
             Light::Quad {
                 corner,
                 edge_u,

@@ -9,6 +9,9 @@
 //! * a **directional light** (irradiance E along direction d) is one isotropic VPL placed
 //!   [`DISTANT_FACTOR`] scene extents up-light, with intensity E·D² so that the irradiance it
 //!   gives at the scene is E up to a relative error of about the scene's size over D (≤ 1e-6);
+//! * a **sun** (irradiance E, angular radius α) is `budget` such distant VPLs in directions
+//!   uniform over its disc (stratified in cos θ, jittered), each carrying E/`budget`: its
+//!   penumbrae by Monte Carlo, E exactly where the whole disc is seen head-on;
 //! * a **quad light** (radiance L, area A) is `budget` cosine VPLs on a jittered grid over the
 //!   quad, each of intensity L·A/`budget` along the quad's normal (Keller 1997: a sample of an
 //!   area light carries I = L A/N);
@@ -47,7 +50,9 @@ pub fn vpl_count(lights: &[Light], budget: u32) -> u64 {
         .iter()
         .map(|l| match l {
             Light::Point { .. } | Light::Directional { .. } => 1,
-            Light::Quad { .. } | Light::Environment { .. } => u64::from(budget.max(1)),
+            Light::Sun { .. } | Light::Quad { .. } | Light::Environment { .. } => {
+                u64::from(budget.max(1))
+            }
         })
         .sum()
 }
@@ -93,6 +98,26 @@ pub fn scene_vpls(
                     center - d * far,
                     irradiance.map(|e| e * far * far),
                 ));
+            }
+            Light::Sun {
+                direction,
+                irradiance,
+                half_angle,
+            } => {
+                // `budget` directions over the disc, stratified in cos θ, each a distant point
+                // light carrying 1/budget of the irradiance: the penumbrae by Monte Carlo.
+                let d = direction.normalize_or_zero();
+                if d == DVec3::ZERO {
+                    continue;
+                }
+                for k in 0..m {
+                    let u1 = (k as f64 + r.random::<f64>()) / m as f64;
+                    let w = crate::lights::cone_direction(-d, *half_angle, u1, r.random());
+                    push(Vpl::point(
+                        center + w * far,
+                        irradiance.map(|e| e * far * far / m as f64),
+                    ));
+                }
             }
             Light::Quad {
                 corner,
@@ -143,7 +168,9 @@ pub fn light_power(light: &Light, radius: f64) -> [f64; 3] {
     let disk = PI * radius * radius;
     match light {
         Light::Point { intensity, .. } => intensity.map(|i| 4.0 * PI * i),
-        Light::Directional { irradiance, .. } => irradiance.map(|e| e * disk),
+        Light::Directional { irradiance, .. } | Light::Sun { irradiance, .. } => {
+            irradiance.map(|e| e * disk)
+        }
         Light::Quad {
             edge_u,
             edge_v,
@@ -221,6 +248,18 @@ pub fn bounce_vpls(
                     if d == DVec3::ZERO {
                         break;
                     }
+                    (disk_point(center - 2.0 * radius * d, d, radius, u1, u2), d)
+                }
+                Light::Sun {
+                    direction,
+                    half_angle,
+                    ..
+                } => {
+                    let axis = direction.normalize_or_zero();
+                    if axis == DVec3::ZERO {
+                        break;
+                    }
+                    let d = -crate::lights::cone_direction(-axis, *half_angle, u3, u4);
                     (disk_point(center - 2.0 * radius * d, d, radius, u1, u2), d)
                 }
                 Light::Quad {

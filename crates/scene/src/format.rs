@@ -53,6 +53,7 @@ pub(super) struct LightDef {
     pub edge_u: Option<[f64; 3]>,
     pub edge_v: Option<[f64; 3]>,
     pub radiance: Option<Triple>,
+    pub angular_diameter: Option<f64>,
 }
 
 /// One `[materials.NAME]` table (keys depend on `type`).
@@ -136,6 +137,7 @@ impl Keys for LightDef {
             ("edge_u", self.edge_u.is_some()),
             ("edge_v", self.edge_v.is_some()),
             ("radiance", self.radiance.is_some()),
+            ("angular_diameter", self.angular_diameter.is_some()),
         ])
     }
 }

@@ -101,6 +101,20 @@ pub enum Light {
         /// Irradiance on a surface perpendicular to the rays.
         irradiance: Rgb,
     },
+    /// A distant disc of angular radius `half_angle` (radians, in (0, π/2)) centred on
+    /// `-direction`, of constant radiance L = E / (π sin² half_angle), so that a surface
+    /// facing it with the whole disc above its horizon receives irradiance E = `irradiance`
+    /// (the integral of L cos θ over the disc is E times the cosine towards its centre): the
+    /// sun with its angular diameter (0.53° seen from the earth), which casts penumbrae where
+    /// a [`Light::Directional`] casts hard shadows.
+    Sun {
+        /// Unit direction the light travels in (from the disc's centre towards the scene).
+        direction: DVec3,
+        /// Irradiance on a surface perpendicular to `direction`.
+        irradiance: Rgb,
+        /// Half the angular diameter, radians.
+        half_angle: f64,
+    },
     /// A one-sided parallelogram emitter `corner + s·edge_u + t·edge_v`, s, t ∈ [0, 1],
     /// emitting constant radiance towards `edge_u × edge_v`.
     Quad {

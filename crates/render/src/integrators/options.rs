@@ -175,12 +175,12 @@ pub const ALPHA: OptionSpec = OptionSpec {
     values: &[],
 };
 
-/// `--vpls N`: VPLs per quad or environment light (`manylight`, `mdlc`, `eelc`).
+/// `--vpls N`: VPLs per sun, quad or environment light (`manylight`, `mdlc`, `eelc`).
 pub const VPLS: OptionSpec = OptionSpec {
     name: "vpls",
     value_name: "N",
     default: "1024",
-    help: "VPLs per quad or environment light (a point or directional light is one VPL)",
+    help: "VPLs per sun, quad or environment light (a point or directional light is one VPL)",
     kind: OptionKind::Value,
     values: &[],
 };

@@ -207,8 +207,8 @@ impl VolPath {
             return Err(Error::Unsupported(format!(
                 "scene `{}`: light {i} is a {kind} light, which a path tracer cannot reach \
                  through a smooth dielectric boundary (the image would miss its light); use \
-                 --boundary lambertian, which reaches it by next-event estimation, or a quad \
-                 or environment light",
+                 --boundary lambertian, which reaches it by next-event estimation, or a quad, \
+                 sun or environment light",
                 scene.name
             )));
         }

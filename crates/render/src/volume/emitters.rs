@@ -1,8 +1,8 @@
 //! The light a path sees when it leaves the translucent objects: quad lights hit by the ray
 //! (one-sided, no geometry: quads block nothing in this renderer, as in its shadow rays) and
-//! the environment where the ray leaves the scene.
+//! the environment and the suns' discs where the ray leaves the scene.
 
-use crate::lights::{background, quad_area_normal};
+use crate::lights::{background, quad_area_normal, sun_radiance};
 use glam::DVec3;
 use sss_bssrdf::Rgb;
 use sss_scene::Light;
@@ -27,12 +27,29 @@ pub struct Emitters {
     quads: Vec<Quad>,
     /// The environment lights' summed radiance.
     environment: Rgb,
+    /// The suns: (unit direction towards the disc's centre, cosine of its angular radius,
+    /// radiance).
+    suns: Vec<(DVec3, f64, Rgb)>,
 }
 
 impl Emitters {
-    /// The quad and environment lights of `lights` (point and directional lights cannot be
-    /// hit by a ray).
+    /// The quad, sun and environment lights of `lights` (point and directional lights cannot
+    /// be hit by a ray).
     pub fn new(lights: &[Light]) -> Self {
+        let suns = lights
+            .iter()
+            .filter_map(|l| match l {
+                Light::Sun {
+                    direction,
+                    irradiance,
+                    half_angle,
+                } => {
+                    let (radiance, _) = sun_radiance(*irradiance, *half_angle)?;
+                    Some((-*direction, half_angle.cos(), radiance))
+                }
+                _ => None,
+            })
+            .collect();
         let quads = lights
             .iter()
             .filter_map(|l| match l {
@@ -60,6 +77,7 @@ impl Emitters {
         Emitters {
             quads,
             environment: background(lights),
+            suns,
         }
     }
 
@@ -90,9 +108,18 @@ impl Emitters {
         l
     }
 
-    /// The radiance of a ray that leaves the scene.
-    pub fn environment(&self) -> Rgb {
-        self.environment
+    /// The radiance of a ray that leaves the scene along the unit `dir`: the environment, and
+    /// every sun whose disc `dir` points into.
+    pub fn escaped(&self, dir: DVec3) -> Rgb {
+        let mut l = self.environment;
+        for (axis, cos_max, radiance) in &self.suns {
+            if dir.dot(*axis) >= *cos_max {
+                for c in 0..3 {
+                    l[c] += radiance[c];
+                }
+            }
+        }
+        l
     }
 }
 
@@ -128,6 +155,31 @@ mod tests {
             e.quads_hit(DVec3::new(0.5, 0.5, 9.0), -up, f64::INFINITY),
             [0.0; 3]
         );
-        assert_eq!(e.environment(), [0.0; 3]);
+        assert_eq!(e.escaped(DVec3::Z), [0.0; 3]);
+    }
+
+    /// A ray leaving the scene sees the environment, plus a sun's radiance
+    /// E / (π sin² α) inside its disc (angular radius α about the direction it comes from)
+    /// and nothing of it outside.
+    #[test]
+    fn escaping_rays_see_the_suns_disc() {
+        let alpha = 0.1f64;
+        let e = Emitters::new(&[
+            Light::Sun {
+                direction: DVec3::new(0.0, 0.0, -1.0),
+                irradiance: [1.0, 2.0, 4.0],
+                half_angle: alpha,
+            },
+            Light::Environment { radiance: [0.5; 3] },
+        ]);
+        let l = 1.0 / (std::f64::consts::PI * alpha.sin().powi(2));
+        let inside = DVec3::new((0.99 * alpha).sin(), 0.0, (0.99 * alpha).cos());
+        let outside = DVec3::new((1.01 * alpha).sin(), 0.0, (1.01 * alpha).cos());
+        let got = e.escaped(inside);
+        for (c, k) in [1.0, 2.0, 4.0].iter().enumerate() {
+            assert!((got[c] - (0.5 + k * l)).abs() < 1e-12 * k * l, "{got:?}");
+        }
+        assert_eq!(e.escaped(outside), [0.5; 3]);
+        assert_eq!(e.escaped(-DVec3::Z), [0.5; 3]);
     }
 }

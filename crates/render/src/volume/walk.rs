@@ -247,7 +247,7 @@ impl Walker<'_> {
                     let t_obj = hit.map_or(f64::INFINITY, |h| h.t);
                     let mut le = self.emitters.quads_hit(origin, dir, t_obj);
                     let Some(hit) = hit else {
-                        let env = self.emitters.environment();
+                        let env = self.emitters.escaped(dir);
                         for c in 0..3 {
                             le[c] += env[c];
                         }

@@ -794,3 +794,56 @@ fn environment_irradiance_with_a_tilted_shading_normal() {
         assert!(all.iter().any(|p| p.len() < m as usize));
     }
 }
+
+/// A sun (a disc of angular radius α and radiance L = E/(π sin²α)) against closed forms:
+/// unoccluded, the irradiance on a surface is E cos θ (∫ L cos dω over the disc is L π sin²α
+/// times the cosine towards its centre, while the whole disc is above the horizon), for a
+/// receiver facing it and one tilted 40°; with an opaque half-plane whose edge passes right
+/// under the disc's centre (a receiver facing the sun, so the cosine is symmetric about the
+/// edge) exactly half; deep in the shadow 0 and clear of it E. Means of 400 seeded estimates
+/// of 16 samples, within 4 standard errors.
+#[test]
+fn sun_irradiance_and_penumbra_match_closed_forms() {
+    let alpha = 5f64.to_radians();
+    let e = 2.0;
+    let sun = Light::Sun {
+        direction: DVec3::new(0.0, -1.0, 0.0),
+        irradiance: [e, 2.0 * e, 0.5 * e],
+        half_angle: alpha,
+    };
+    // An opaque half-plane at height 1: x < 0 (a 40 × 40 square centred at x = -20).
+    let mut blocker = super::common::square(40.0, 4);
+    for p in &mut blocker.positions {
+        *p += DVec3::new(-20.0, 1.0, 0.0);
+    }
+    let scene = scene_of(
+        vec![blocker],
+        diffuse(),
+        vec![sun],
+        camera(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 30.0, 4, 4),
+    );
+    let up = DVec3::Y;
+    let tilt = DVec3::new(0.0, 40f64.to_radians().cos(), 40f64.to_radians().sin());
+    // (position, normal, expected fraction of E)
+    let cases = [
+        (DVec3::new(5.0, 0.0, 0.0), up, 1.0),
+        (DVec3::new(5.0, 0.0, 0.0), tilt, 40f64.to_radians().cos()),
+        (DVec3::new(0.0, 0.0, 0.0), up, 0.5),
+        (DVec3::new(-1.0, 0.0, 0.0), up, 0.0),
+    ];
+    for (p, n, fraction) in cases {
+        for ch in 0..3 {
+            let (mean, se, _) = gather_stats(&scene, Receiver { p, n, ng: n }, 16, 400, 7, ch);
+            let want = fraction * [e, 2.0 * e, 0.5 * e][ch];
+            println!("sun at {p} n {n}: {mean} (want {want}, se {se})");
+            assert!(
+                (mean - want).abs() <= 4.0 * se + 1e-9 * want,
+                "at {p}, n {n}, channel {ch}: {mean} ± {se}, want {want}"
+            );
+            if fraction == 1.0 || fraction == 0.0 {
+                // Unoccluded facing the sun every sample is near E; in the umbra none lands.
+                assert!(se <= 1e-3 * want.max(1.0), "se {se}");
+            }
+        }
+    }
+}

@@ -1,4 +1,4 @@
-//! The `[[lights]]` tables: point, directional, quad and environment lights.
+//! The `[[lights]]` tables: point, directional, sun, quad and environment lights.
 
 use super::context::{Ctx, list};
 use crate::format::{Keys, LightDef};
@@ -6,7 +6,7 @@ use crate::{Light, SceneError};
 
 impl Ctx<'_> {
     pub(super) fn light(&self, l: &LightDef, path: &str) -> Result<Light, SceneError> {
-        let types = ["point", "directional", "quad", "environment"];
+        let types = ["point", "directional", "sun", "quad", "environment"];
         let present = l.present();
         let what = format!("a {} light", l.kind);
         let key = |k: &str| format!("{path}.{k}");
@@ -27,6 +27,32 @@ impl Ctx<'_> {
                 Ok(Light::Directional {
                     direction: self.nonzero_vec(d, &key("direction"))?.normalize(),
                     irradiance: self.emission(e, &key("irradiance"))?,
+                })
+            }
+            "sun" => {
+                self.check_keys(
+                    path,
+                    &present,
+                    &["direction", "irradiance", "angular_diameter"],
+                    &what,
+                )?;
+                let d = self.required(l.direction, path, "direction", &what)?;
+                let e = self.required(l.irradiance, path, "irradiance", &what)?;
+                // The sun's angular diameter seen from the earth, in degrees.
+                let deg = l.angular_diameter.unwrap_or(0.53);
+                if !(deg.is_finite() && deg > 0.0 && deg < 180.0) {
+                    return Err(self.err(
+                        &key("angular_diameter"),
+                        format!(
+                            "is {deg}; it must be an angle in degrees above 0 and below 180 \
+                             (the sun's is 0.53; a point-like source is a `directional` light)"
+                        ),
+                    ));
+                }
+                Ok(Light::Sun {
+                    direction: self.nonzero_vec(d, &key("direction"))?.normalize(),
+                    irradiance: self.emission(e, &key("irradiance"))?,
+                    half_angle: (0.5 * deg).to_radians(),
                 })
             }
             "quad" => {

@@ -426,6 +426,56 @@ fn light_errors() {
     );
 }
 
+/// A sun: the directional light with a disc of finite angular diameter (degrees in the file,
+/// half the angle in radians in the scene; 0.53°, the sun's, by default).
+#[test]
+fn sun_lights() {
+    let sun = |extra: &str| {
+        with(
+            "type = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nirradiance = 1.0",
+            &format!("type = \"sun\"\ndirection = [0.0, -2.0, 0.0]\nirradiance = 3.0{extra}"),
+        )
+    };
+    let half = |text: &str| match load_str(text, "sun.toml", None, &no_dirs()).unwrap().lights[1] {
+        Light::Sun {
+            direction,
+            irradiance,
+            half_angle,
+        } => {
+            assert_eq!(direction, DVec3::new(0.0, -1.0, 0.0));
+            assert_eq!(irradiance, [3.0; 3]);
+            half_angle
+        }
+        ref other => panic!("not a sun: {other:?}"),
+    };
+    assert!((half(&sun("")) - 0.265f64.to_radians()).abs() < 1e-15);
+    assert!((half(&sun("\nangular_diameter = 10.0")) - 5f64.to_radians()).abs() < 1e-15);
+    for bad in ["0.0", "-1.0", "180.0", "nan"] {
+        assert_err(
+            &sun(&format!("\nangular_diameter = {bad}")),
+            Some("angular_diameter"),
+            Some("lights[1].angular_diameter"),
+            &["degrees above 0 and below 180"],
+        );
+    }
+    // Only a sun takes an angular diameter.
+    assert_err(
+        &with(
+            "intensity = [10.0, 10.0, 10.0]",
+            "intensity = 1.0\nangular_diameter = 1.0",
+        ),
+        Some("angular_diameter"),
+        Some("lights[0].angular_diameter"),
+        &["does not apply to a point light"],
+    );
+    assert_err(
+        &with("type = \"point\"", "type = \"spot\""),
+        None,
+        None,
+        &["sun"],
+    );
+}
+
 #[test]
 fn material_errors() {
     assert_err(

@@ -162,7 +162,7 @@ pub struct ManyLight {
     pub alpha: f64,
     /// Cluster selection.
     pub selection: Selection,
-    /// VPLs per quad or environment light.
+    /// VPLs per sun, quad or environment light.
     pub vpls: u32,
     /// Cap on the triplets per pixel and object.
     pub max_triplets: usize,

@@ -81,7 +81,7 @@ pub struct PointOptions {
     pub irradiance_points: u32,
     /// Uniform by area instead of BSSRDF importance sampling.
     pub uniform: bool,
-    /// VPLs per quad or environment light.
+    /// VPLs per sun, quad or environment light.
     pub vpls: u32,
     /// Cap on the pairs per pixel and object.
     pub max_pairs: usize,
