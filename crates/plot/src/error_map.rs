@@ -48,8 +48,71 @@ pub fn diverging_colour(t: f64) -> [u8; 3] {
     [0, 1, 2].map(|k| (255.0 * (1.0 - f) + end[k] * f).round() as u8)
 }
 
+/// The colour of a value beyond a map's range (above `max`, or below `-max` on a signed
+/// map): a saturated green, found in neither the inferno nor the blue-white-red map, shown
+/// as a swatch above the colour bar with the count of such pixels.
+pub const OVER_RANGE: [u8; 3] = [0, 220, 0];
+
+/// How an unsigned map's values become colours: linear over [0, `max`], or with `log`
+/// logarithmic over [`max`·10⁻³, `max`] (three decades; smaller values at the bottom colour).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapScale {
+    /// The top of the colour bar; larger values are drawn [`OVER_RANGE`].
+    pub max: f64,
+    /// Three decades on a log scale instead of a linear one.
+    pub log: bool,
+}
+
+/// Decades a log-scaled map spans.
+const LOG_DECADES: f64 = 3.0;
+
+impl MapScale {
+    /// A non-positive or non-finite `max` counts as 1.
+    fn max(&self) -> f64 {
+        if self.max.is_finite() && self.max > 0.0 {
+            self.max
+        } else {
+            1.0
+        }
+    }
+
+    /// The colour of value `v` (non-negative): the inferno map at its position on the bar,
+    /// [`OVER_RANGE`] above `max`.
+    pub fn colour(&self, v: f64) -> [u8; 3] {
+        let max = self.max();
+        if v > max {
+            return OVER_RANGE;
+        }
+        false_colour(self.position(v))
+    }
+
+    /// Where `v` sits on the bar, 0 (bottom) to 1 (top).
+    pub fn position(&self, v: f64) -> f64 {
+        let max = self.max();
+        if !self.log {
+            return (v / max).clamp(0.0, 1.0);
+        }
+        let lo = max * 10f64.powf(-LOG_DECADES);
+        if !(v > lo) {
+            return 0.0;
+        }
+        ((v / lo).log10() / LOG_DECADES).clamp(0.0, 1.0)
+    }
+
+    /// The value at bar position `t`.
+    pub fn value_at(&self, t: f64) -> f64 {
+        let max = self.max();
+        if self.log {
+            max * 10f64.powf(LOG_DECADES * (t - 1.0))
+        } else {
+            t * max
+        }
+    }
+}
+
 /// Draws a false-colour map of per-pixel `values` (None: not part of the comparison, drawn
 /// grey) scaled from 0 to `max`, with a colour bar labelled `label` and a title, as a PNG.
+/// Values above `max` are drawn [`OVER_RANGE`] and counted beside the bar.
 pub fn write_error_map(
     path: &Path,
     width: u32,
@@ -59,13 +122,33 @@ pub fn write_error_map(
     title: &str,
     label: &str,
 ) -> Result<(), PlotError> {
+    let scale = MapScale { max, log: false };
+    write_error_map_with(path, width, height, values, &scale, title, label)
+}
+
+/// [`write_error_map`] on a chosen scale (linear or three decades of log).
+pub fn write_error_map_with(
+    path: &Path,
+    width: u32,
+    height: u32,
+    values: &[Option<f64>],
+    scale: &MapScale,
+    title: &str,
+    label: &str,
+) -> Result<(), PlotError> {
     let image = MapImage {
         path,
         width,
         height,
         values,
     };
-    draw_scaled(&image, max, false, title, label)
+    let map = Map {
+        colour: &|v| scale.colour(v),
+        bar: &|t| false_colour(t),
+        tick: &|t| scale.value_at(t),
+        over: &|v| v > scale.max(),
+    };
+    draw_map(&image, &map, title, label)
 }
 
 /// Draws a map of signed per-pixel `values` (None: drawn grey) from −`max` (blue) through 0
@@ -86,7 +169,24 @@ pub fn write_signed_map(
         height,
         values,
     };
-    draw_scaled(&image, max, true, title, label)
+    let max = if max.is_finite() && max > 0.0 {
+        max
+    } else {
+        1.0
+    };
+    let map = Map {
+        colour: &|v| {
+            if v.abs() > max {
+                OVER_RANGE
+            } else {
+                diverging_colour(v / max)
+            }
+        },
+        bar: &|t| diverging_colour(2.0 * t - 1.0),
+        tick: &|t| (2.0 * t - 1.0) * max,
+        over: &|v| v.abs() > max,
+    };
+    draw_map(&image, &map, title, label)
 }
 
 /// Where a map goes and what it shows.
@@ -97,42 +197,13 @@ struct MapImage<'a> {
     values: &'a [Option<f64>],
 }
 
-/// A map of `image`'s values over [0, max] in false colour, or over [−max, max] in the
-/// diverging colours when `signed` (a non-positive or non-finite `max` counts as 1).
-fn draw_scaled(
-    image: &MapImage<'_>,
-    max: f64,
-    signed: bool,
-    title: &str,
-    label: &str,
-) -> Result<(), PlotError> {
-    let max = if max.is_finite() && max > 0.0 {
-        max
-    } else {
-        1.0
-    };
-    let map = if signed {
-        Map {
-            colour: &|v| diverging_colour(v / max),
-            bar: &|t| diverging_colour(2.0 * t - 1.0),
-            tick: &|t| (2.0 * t - 1.0) * max,
-        }
-    } else {
-        Map {
-            colour: &|v| false_colour(v / max),
-            bar: &|t| false_colour(t),
-            tick: &|t| t * max,
-        }
-    };
-    draw_map(image, &map, title, label)
-}
-
 /// How values become colours: a value's colour, the bar's colour at t ∈ [0, 1] (bottom to
-/// top) and the value a bar position stands for.
+/// top), the value a bar position stands for, and whether a value lies beyond the range.
 struct Map<'a> {
     colour: &'a dyn Fn(f64) -> [u8; 3],
     bar: &'a dyn Fn(f64) -> [u8; 3],
     tick: &'a dyn Fn(f64) -> f64,
+    over: &'a dyn Fn(f64) -> bool,
 }
 
 fn draw_map(
@@ -160,8 +231,17 @@ fn draw_map(
     crate::check_writable(path)?;
     let scale = (512 / width.max(height)).clamp(1, 8);
     let (iw, ih) = (width * scale, height * scale);
-    let (bar_w, margin, title_h) = (150u32, 10u32, 30u32);
-    let size = (iw + bar_w + 2 * margin, ih.max(200) + title_h + 2 * margin);
+    let over = values.iter().flatten().filter(|v| (map.over)(**v)).count();
+    let over_text = format!("{over} px beyond the range");
+    // Wide enough for the tick labels, the bar's label and the over-range count (about 7
+    // pixels a character at 13 px).
+    let text_w = 7 * label.chars().count().max(over_text.chars().count()) as u32;
+    let (bar_w, margin, title_h) = (150u32.max(text_w + 30), 10u32, 30u32);
+    // 20 pixels under the bar for its label (which the bottom margin alone used to clip).
+    let size = (
+        iw + bar_w + 2 * margin,
+        ih.max(200) + title_h + 2 * margin + 20,
+    );
     crate::ensure_font()?;
     let draw = |tmp: &Path| -> Result<(), String> {
         let root = BitMapBackend::new(tmp, size).into_drawing_area();
@@ -191,9 +271,18 @@ fn draw_map(
                 }
             }
         }
-        // Colour bar.
+        // Colour bar, under the over-range swatch.
         let bx = ox + iw as i32 + 20;
-        let bh = ih.max(200) as i32;
+        let style = ("sans-serif", 13).into_text_style(&root);
+        root.draw(&Rectangle::new(
+            [(bx, oy), (bx + 20, oy + 14)],
+            RGBColor(OVER_RANGE[0], OVER_RANGE[1], OVER_RANGE[2]).filled(),
+        ))
+        .map_err(|e| e.to_string())?;
+        root.draw_text(&over_text, &style, (bx + 26, oy))
+            .map_err(|e| e.to_string())?;
+        let oy = oy + 24;
+        let bh = ih.max(200) as i32 - 24;
         for j in 0..bh {
             let t = 1.0 - j as f64 / (bh - 1).max(1) as f64;
             let col = (map.bar)(t);
@@ -203,14 +292,13 @@ fn draw_map(
             ))
             .map_err(|e| e.to_string())?;
         }
-        let style = ("sans-serif", 13).into_text_style(&root);
         for k in 0..=4 {
             let t = k as f64 / 4.0;
             let yy = oy + ((1.0 - t) * (bh - 1) as f64) as i32;
             root.draw_text(&format!("{:.3e}", (map.tick)(t)), &style, (bx + 26, yy - 6))
                 .map_err(|e| e.to_string())?;
         }
-        root.draw_text(label, &style, (bx - 10, oy + bh + 4))
+        root.draw_text(label, &style, (bx, oy + bh + 4))
             .map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())
     };
@@ -237,6 +325,44 @@ mod tests {
         let (a, b) = (diverging_colour(-0.3), diverging_colour(0.3));
         assert!(a[2] > a[0] && b[0] > b[2]);
         assert!(sum(diverging_colour(0.6)) < sum(b) && sum(diverging_colour(-0.6)) < sum(a));
+    }
+
+    #[test]
+    fn values_beyond_the_range_are_marked_and_the_log_scale_spans_three_decades() {
+        let lin = MapScale {
+            max: 0.2,
+            log: false,
+        };
+        assert_eq!(lin.colour(0.2), false_colour(1.0));
+        assert_eq!(lin.colour(0.2000001), OVER_RANGE);
+        assert_eq!(lin.colour(0.1), false_colour(0.5));
+        // The marker is in neither map.
+        for k in 0..=100 {
+            let t = k as f64 / 100.0;
+            assert_ne!(false_colour(t), OVER_RANGE);
+            assert_ne!(diverging_colour(2.0 * t - 1.0), OVER_RANGE);
+        }
+        let log = MapScale {
+            max: 0.2,
+            log: true,
+        };
+        assert!((log.position(0.2) - 1.0).abs() < 1e-12);
+        assert!((log.position(0.02) - 2.0 / 3.0).abs() < 1e-12);
+        assert!((log.position(0.002) - 1.0 / 3.0).abs() < 1e-12);
+        assert_eq!(log.position(0.0002), 0.0);
+        assert_eq!(log.position(0.0), 0.0);
+        assert_eq!(log.colour(0.3), OVER_RANGE);
+        for t in [0.0, 0.25, 0.5, 1.0] {
+            assert!((log.position(log.value_at(t)) - t).abs() < 1e-12);
+            assert!((lin.position(lin.value_at(t)) - t).abs() < 1e-12);
+        }
+        // Bad maxima count as 1.
+        let bad = MapScale {
+            max: f64::NAN,
+            log: false,
+        };
+        assert_eq!(bad.colour(1.0), false_colour(1.0));
+        assert_eq!(bad.colour(1.5), OVER_RANGE);
     }
 
     #[test]

@@ -42,7 +42,10 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 mod error_map;
-pub use error_map::{diverging_colour, false_colour, write_error_map, write_signed_map};
+pub use error_map::{
+    MapScale, OVER_RANGE, diverging_colour, false_colour, write_error_map, write_error_map_with,
+    write_signed_map,
+};
 
 /// A log y axis spans at most this many decades below its largest value.
 pub const MAX_LOG_DECADES: f64 = 10.0;

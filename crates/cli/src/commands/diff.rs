@@ -6,7 +6,7 @@ use crate::commands::render::check_output;
 use crate::plot_error;
 use clap::Args;
 use sss_bssrdf::Rgb;
-use sss_plot::write_error_map;
+use sss_plot::{MapScale, write_error_map_with};
 use sss_render::Error;
 use sss_render::image::{check_exr_budget, read_exr_within};
 use sss_render::metrics::{error_figures, mean_ratio_rgb, relative_errors};
@@ -27,9 +27,16 @@ pub struct DiffArgs {
     /// another renderer's EXR, say.
     #[arg(long, value_name = "NAME")]
     pub reference_layer: Option<String>,
-    /// False-colour error map (PNG) of the relative error per pixel.
+    /// False-colour error map (PNG) of the relative error per pixel; pixels beyond the range
+    /// are drawn green and counted beside the colour bar.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
+    /// The top of the error map's colour bar (a relative error). Default: 4 × --eps.
+    #[arg(long, value_name = "MAX")]
+    pub range: Option<f64>,
+    /// The error map on a log scale: three decades below --range.
+    #[arg(long)]
+    pub log: bool,
     /// Relative-error threshold for the fraction of pixels within it.
     #[arg(long, default_value_t = 0.05)]
     pub eps: f64,
@@ -43,6 +50,13 @@ pub struct DiffArgs {
 pub fn run(args: &DiffArgs) -> Result<String, Error> {
     if let Some(p) = &args.png {
         check_output(p, "png")?;
+    }
+    if let Some(r) = args.range
+        && !(r.is_finite() && r > 0.0)
+    {
+        return Err(Error::Input(format!(
+            "--range must be a finite relative error > 0, got {r}"
+        )));
     }
     let budget = args
         .max_memory
@@ -90,14 +104,21 @@ pub fn run(args: &DiffArgs) -> Result<String, Error> {
         for (k, &i) in pixels.iter().enumerate() {
             values[i] = Some(rel[k]);
         }
-        let max = 4.0 * args.eps;
-        write_error_map(
+        let scale = MapScale {
+            max: args.range.unwrap_or(4.0 * args.eps),
+            log: args.log,
+        };
+        write_error_map_with(
             p,
             w,
             h,
             &values,
-            max,
-            &format!("relative error, layer {}", args.layer),
+            &scale,
+            &format!(
+                "relative error, layer {}{}",
+                args.layer,
+                if args.log { " (log scale)" } else { "" }
+            ),
             "|a-b|/b",
         )
         .map_err(plot_error)?;

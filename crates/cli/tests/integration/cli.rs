@@ -605,6 +605,49 @@ fn render_writes_exr_and_png_and_reports_stages() {
     assert!(same.contains("rmse 0.000000e0"), "{same}");
     assert!(std::fs::metadata(&err_png).unwrap().len() > 100);
 
+    // The map's range: pixels beyond it are drawn in the over-range green (besides its
+    // 20 × 14 swatch by the colour bar); a range above every error leaves only the swatch.
+    let green = |range: &str, log: bool| -> usize {
+        let mut args = vec![
+            "diff",
+            exr.to_str().unwrap(),
+            reference.to_str().unwrap(),
+            "--png",
+            err_png.to_str().unwrap(),
+            "--range",
+            range,
+        ];
+        if log {
+            args.push("--log");
+        }
+        ok(&args);
+        let decoder = png::Decoder::new(std::io::BufReader::new(
+            std::fs::File::open(&err_png).unwrap(),
+        ));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let step = info.color_type.samples();
+        buf[..info.buffer_size()]
+            .chunks_exact(step)
+            .filter(|p| p[..3] == sss_plot::OVER_RANGE)
+            .count()
+    };
+    let swatch = 20 * 14;
+    assert_eq!(green("1e9", false), swatch);
+    assert_eq!(green("1e9", true), swatch);
+    let over = green("1e-9", false);
+    assert!(over > swatch + 1000, "{over} green pixels");
+    let e = sss(&[
+        "diff",
+        exr.to_str().unwrap(),
+        reference.to_str().unwrap(),
+        "--range",
+        "0",
+    ]);
+    assert!(!e.status.success());
+    assert!(String::from_utf8_lossy(&e.stderr).contains("--range must be"));
+
     // Another renderer's EXR: its plain R,G,B (`beauty`) against our `subsurface`, each side
     // naming its layer; the same figures as against our own file.
     let (rw, rh, ref_layers) = sss_render::image::read_exr(&reference).unwrap();
