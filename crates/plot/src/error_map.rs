@@ -66,14 +66,18 @@ pub struct MapScale {
 /// Decades a log-scaled map spans.
 const LOG_DECADES: f64 = 3.0;
 
+/// A map's range: `max`, or 1 for a non-positive or non-finite one.
+fn usable_max(max: f64) -> f64 {
+    if max.is_finite() && max > 0.0 {
+        max
+    } else {
+        1.0
+    }
+}
+
 impl MapScale {
-    /// A non-positive or non-finite `max` counts as 1.
     fn max(&self) -> f64 {
-        if self.max.is_finite() && self.max > 0.0 {
-            self.max
-        } else {
-            1.0
-        }
+        usable_max(self.max)
     }
 
     /// The colour of value `v` (non-negative): the inferno map at its position on the bar,
@@ -146,7 +150,6 @@ pub fn write_error_map_with(
         colour: &|v| scale.colour(v),
         bar: &|t| false_colour(t),
         tick: &|t| scale.value_at(t),
-        over: &|v| v > scale.max(),
     };
     draw_map(&image, &map, title, label)
 }
@@ -169,11 +172,7 @@ pub fn write_signed_map(
         height,
         values,
     };
-    let max = if max.is_finite() && max > 0.0 {
-        max
-    } else {
-        1.0
-    };
+    let max = usable_max(max);
     let map = Map {
         colour: &|v| {
             if v.abs() > max {
@@ -184,7 +183,6 @@ pub fn write_signed_map(
         },
         bar: &|t| diverging_colour(2.0 * t - 1.0),
         tick: &|t| (2.0 * t - 1.0) * max,
-        over: &|v| v.abs() > max,
     };
     draw_map(&image, &map, title, label)
 }
@@ -197,13 +195,12 @@ struct MapImage<'a> {
     values: &'a [Option<f64>],
 }
 
-/// How values become colours: a value's colour, the bar's colour at t ∈ [0, 1] (bottom to
-/// top), the value a bar position stands for, and whether a value lies beyond the range.
+/// How values become colours: a value's colour ([`OVER_RANGE`] beyond the range), the bar's
+/// colour at t ∈ [0, 1] (bottom to top) and the value a bar position stands for.
 struct Map<'a> {
     colour: &'a dyn Fn(f64) -> [u8; 3],
     bar: &'a dyn Fn(f64) -> [u8; 3],
     tick: &'a dyn Fn(f64) -> f64,
-    over: &'a dyn Fn(f64) -> bool,
 }
 
 fn draw_map(
@@ -231,7 +228,16 @@ fn draw_map(
     crate::check_writable(path)?;
     let scale = (512 / width.max(height)).clamp(1, 8);
     let (iw, ih) = (width * scale, height * scale);
-    let over = values.iter().flatten().filter(|v| (map.over)(**v)).count();
+    // Each pixel's colour once: drawn, and counted where it marks a value beyond the range.
+    let colours: Vec<[u8; 3]> = values
+        .iter()
+        .map(|v| v.map_or([128, 128, 128], |v| (map.colour)(v)))
+        .collect();
+    let over = values
+        .iter()
+        .zip(&colours)
+        .filter(|(v, c)| v.is_some() && **c == OVER_RANGE)
+        .count();
     let over_text = format!("{over} px beyond the range");
     // Wide enough for the tick labels, the bar's label and the over-range count (about 7
     // pixels a character at 13 px).
@@ -255,10 +261,7 @@ fn draw_map(
         let (ox, oy) = (margin as i32, (title_h + margin) as i32);
         for y in 0..height {
             for x in 0..width {
-                let col = match values[(y * width + x) as usize] {
-                    Some(v) => (map.colour)(v),
-                    None => [128, 128, 128],
-                };
+                let col = colours[(y * width + x) as usize];
                 let c = RGBColor(col[0], col[1], col[2]);
                 for dy in 0..scale {
                     for dx in 0..scale {

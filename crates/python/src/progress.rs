@@ -73,8 +73,8 @@ impl sss_render::progress::Progress for Monitor {
 
 /// The bar `progress=True` shows: one line on `sys.stderr`, redrawn with a carriage return
 /// (as tqdm draws in a terminal and in a notebook's output cell), `label  37% 2390/6456
-/// [00:03 < 00:05]`, the remaining time `estimating` until a second has passed and 1 % is
-/// done (the command line's rule), a line break once everything is done.
+/// [00:03 < 5 seconds]`, the remaining time as the command line's bar gives it
+/// ([`sss_cli::progress::eta_text`]), a line break once everything is done.
 #[pyclass(name = "TextBar", module = "sss")]
 pub struct TextBar {
     label: String,
@@ -105,11 +105,7 @@ impl TextBar {
         } else {
             Duration::ZERO
         };
-        let eta = if elapsed < Duration::from_secs(1) || fraction < 0.01 {
-            "estimating".to_string()
-        } else {
-            clock(eta)
-        };
+        let eta = sss_cli::progress::eta_text(elapsed, fraction as f32, eta);
         format!(
             "{} {:3.0}% {done}/{total} [{} < {eta}]",
             self.label,

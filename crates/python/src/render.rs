@@ -53,19 +53,17 @@ fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene
 
 /// The options of `method` among those `given`, and a warning for each option given that
 /// another method takes (ignored, as the command line ignores another method's flag with a
-/// warning). An option no method takes is a `ValueError` (a misspelling, most likely) naming
+/// warning). An option no method takes is a `TypeError` (a misspelling, most likely) naming
 /// the options `method` does take.
 fn options_of(method: &str, given: &MethodOptions) -> PyResult<(MethodOptions, Vec<String>)> {
     let m = guard(|| integrators::method(method).map_err(to_py))?;
     let keyword = |name: &str| name.replace('-', "_");
-    let mut options = MethodOptions::new();
+    let (options, others) = given.partition(m);
     let mut ignored = Vec::new();
-    for name in given.names() {
-        if m.options.iter().any(|o| o.name == name) {
-            options.set(name, given.value(name).unwrap_or_default());
-        } else if integrators::METHODS
+    for name in &others {
+        if integrators::METHODS
             .iter()
-            .any(|other| other.options.iter().any(|o| o.name == name))
+            .any(|other| other.options.iter().any(|o| o.name == *name))
         {
             ignored.push(format!(
                 "{} is not an option of method {method}; ignored",

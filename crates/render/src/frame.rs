@@ -180,21 +180,23 @@ impl Frame<'_> {
     /// it, the points a method shades, and its profile's reach: where its irradiance samples
     /// are needed ([`irradiance::compute_for`]).
     pub fn shaded_points(&self) -> Vec<irradiance::ShadedPoints> {
-        self.visible
+        let mut out: Vec<irradiance::ShadedPoints> = self
+            .visible
             .iter()
             .map(|&o| irradiance::ShadedPoints {
-                points: self
-                    .gbuffer
-                    .samples
-                    .iter()
-                    .filter(|g| g.object == o)
-                    .map(|g| g.p)
-                    .collect(),
+                points: Vec::new(),
                 reach: self.shading_of(o).map_or(f64::INFINITY, |sh| {
                     irradiance::reach(sh.bssrdf(), sh.units_per_mm)
                 }),
             })
-            .collect()
+            .collect();
+        // One pass over the G-buffer (`visible` is ascending).
+        for g in &self.gbuffer.samples {
+            if let Ok(k) = self.visible.binary_search(&g.object) {
+                out[k].points.push(g.p);
+            }
+        }
+        out
     }
 
     /// About how many irradiance samples the ones built so far left out as out of reach of

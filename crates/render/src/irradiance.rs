@@ -177,7 +177,7 @@ fn within_reach(tris: &[[DVec3; 3]], points: &[DVec3], radius: f64) -> Vec<u32> 
     for &p in points.iter().filter(|p| p.is_finite()) {
         grid.entry(cell(p)).or_default().push(p);
     }
-    let finite: Vec<DVec3> = grid.values().flatten().copied().collect();
+    let count = grid.values().map(Vec::len).sum::<usize>();
     (0..tris.len() as u32)
         .into_par_iter()
         .filter(|&t| {
@@ -190,8 +190,8 @@ fn within_reach(tris: &[[DVec3; 3]], points: &[DVec3], radius: f64) -> Vec<u32> 
             let inside = |p: &DVec3| p.cmpge(lo).all() && p.cmple(hi).all();
             let (cl, ch) = (cell(lo), cell(hi));
             let cells = (0..3).fold(1u128, |n, k| n * (ch[k] - cl[k] + 1).max(0) as u128);
-            if cells > finite.len() as u128 {
-                return finite.iter().any(inside);
+            if cells > count as u128 {
+                return grid.values().flatten().any(inside);
             }
             for x in cl[0]..=ch[0] {
                 for y in cl[1]..=ch[1] {
@@ -227,20 +227,15 @@ fn compute_within(
             let spacing = settings.spacing_mfp * mfp_mm * mat.units_per_mm;
             let mesh = geom.mesh(o);
             let all = triangles_of(mesh);
-            // The triangles sampled (indices into the mesh's), and the area left out.
-            let (kept, left_out_area) = match shaded.and_then(|s| s.get(k)) {
+            // The triangles sampled (indices into the mesh's), and the whole mesh's area when
+            // some were left out (the sampled area is the placement's).
+            let (kept, whole_area) = match shaded.and_then(|s| s.get(k)) {
                 Some(s) if s.reach.is_finite() => {
-                    let kept = within_reach(&all, &s.points, s.reach);
                     let area = |t: &[DVec3; 3]| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
-                    let total: f64 = all.iter().map(area).filter(|a| a.is_finite()).sum();
-                    let kept_area: f64 = kept
-                        .iter()
-                        .map(|&t| area(&all[t as usize]))
-                        .filter(|a| a.is_finite())
-                        .sum();
-                    (kept, (total - kept_area).max(0.0))
+                    let whole: f64 = all.iter().map(area).filter(|a| a.is_finite()).sum();
+                    (within_reach(&all, &s.points, s.reach), Some(whole))
                 }
-                _ => ((0..all.len() as u32).collect(), 0.0),
+                _ => ((0..all.len() as u32).collect(), None),
             };
             let tris: Vec<[DVec3; 3]> = kept.iter().map(|&t| all[t as usize]).collect();
             let place_seed = sss_util::splitmix64(
@@ -248,10 +243,12 @@ fn compute_within(
             );
             let (points, stats) =
                 sss_hierarchy::blue_noise_on_mesh(&tris, spacing, settings.max_samples, place_seed);
-            let left_out = if left_out_area > 0.0 && stats.surface_area > 0.0 {
-                (points.len() as f64 * left_out_area / stats.surface_area).round() as usize
-            } else {
-                0
+            let left_out = match whole_area {
+                Some(whole) if whole > stats.surface_area && stats.surface_area > 0.0 => {
+                    (points.len() as f64 * (whole - stats.surface_area) / stats.surface_area)
+                        .round() as usize
+                }
+                _ => 0,
             };
             let directional = mat.model == ModelKind::DirectionalDipole;
             let eta = medium.eta();

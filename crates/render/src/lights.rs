@@ -187,8 +187,6 @@ pub(crate) fn quad_area_normal(edge_u: DVec3, edge_v: DVec3) -> Option<(f64, DVe
     (area > 0.0 && area.is_finite()).then(|| (area, cross / area))
 }
 
-/// A point of the unit square in stratum `k` of `m` equal strips along the first axis (uniform
-/// overall, with less variance than independent points).
 /// A sun's radiance L = E / (π sin² α) and its solid angle Ω = 2π(1 − cos α) = 4π sin²(α/2),
 /// for irradiance `irradiance` at normal incidence and angular radius `half_angle` = α (the
 /// integral of L cos θ over the disc seen head-on is L π sin² α). None for an angle outside
@@ -218,7 +216,9 @@ pub fn cone_direction(axis: DVec3, half_angle: f64, u1: f64, u2: f64) -> DVec3 {
     (a * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + axis * cos_t).normalize_or(axis)
 }
 
-fn stratum(k: u32, m: u32, rng: &mut Pcg64Mcg) -> (f64, f64) {
+/// A point of the unit square in stratum `k` of `m` equal strips along the first axis (uniform
+/// overall, with less variance than independent points).
+pub(crate) fn stratum(k: u32, m: u32, rng: &mut Pcg64Mcg) -> (f64, f64) {
     let u = ((k as f64 + rng.random::<f64>()) / m as f64).min(1.0 - f64::EPSILON / 2.0);
     (u, rng.random::<f64>())
 }

@@ -243,6 +243,31 @@ pub fn subset_error(
     }
 }
 
+/// The pixels of `pixels` (ascending indices of a `width` × `height` image) whose eight
+/// neighbours are in `pixels` too (none on the image's border): where a silhouette or a mask
+/// is whole around a pixel, so that two renderers' pixels there mean the same thing.
+pub fn interior_pixels(pixels: &[usize], width: u32, height: u32) -> Vec<usize> {
+    let (w, h) = (width as usize, height as usize);
+    let mut on = vec![false; w * h];
+    for &i in pixels {
+        if i < on.len() {
+            on[i] = true;
+        }
+    }
+    pixels
+        .iter()
+        .copied()
+        .filter(|&i| {
+            let (x, y) = (i % w, i / w);
+            x > 0
+                && y > 0
+                && x + 1 < w
+                && y + 1 < h
+                && (0..9).all(|k| on[(y + k / 3 - 1) * w + x + k % 3 - 1])
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -196,7 +196,7 @@ pub fn check_scene(scene: &Scene) -> Result<(), crate::Error> {
                 vec![*direction],
                 if (direction.length() - 1.0).abs() > UNIT_TOLERANCE {
                     Some("the direction is not a unit vector")
-                } else if !(*half_angle > 0.0 && *half_angle <= 0.5 * std::f64::consts::PI) {
+                } else if crate::lights::sun_radiance(*irradiance, *half_angle).is_none() {
                     Some("the half angle is not in (0, π/2]")
                 } else {
                     None

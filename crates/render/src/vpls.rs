@@ -110,9 +110,9 @@ pub fn scene_vpls(
                 if d == DVec3::ZERO {
                     continue;
                 }
-                for k in 0..m {
-                    let u1 = (k as f64 + r.random::<f64>()) / m as f64;
-                    let w = crate::lights::cone_direction(-d, *half_angle, u1, r.random());
+                for k in 0..budget {
+                    let (u1, u2) = crate::lights::stratum(k, budget, &mut r);
+                    let w = crate::lights::cone_direction(-d, *half_angle, u1, u2);
                     push(Vpl::point(
                         center + w * far,
                         irradiance.map(|e| e * far * far / m as f64),

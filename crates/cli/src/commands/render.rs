@@ -81,14 +81,9 @@ pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 /// The integrator `--method` and its flags describe. Flags of other methods are ignored with a
 /// warning on stderr.
 pub fn integrator(method: &str, given: &MethodOptions) -> Result<Box<dyn Integrator>, Error> {
-    let m = integrators::method(method)?;
-    let mut options = MethodOptions::new();
-    for name in given.names() {
-        if m.options.iter().any(|o| o.name == name) {
-            options = options.with(name, given.value(name).unwrap_or_default());
-        } else {
-            eprintln!("warning: --{name} is not an option of method {method}; ignored");
-        }
+    let (options, others) = given.partition(integrators::method(method)?);
+    for name in others {
+        eprintln!("warning: --{name} is not an option of method {method}; ignored");
     }
     integrators::build(method, &options)
 }

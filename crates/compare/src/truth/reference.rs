@@ -6,6 +6,10 @@
 
 use super::*;
 
+/// The pixels whose eight neighbours are scored too (the rule is shared:
+/// `sss_render::metrics::interior_pixels`).
+pub(crate) use sss_render::metrics::interior_pixels as interior;
+
 /// Bumped whenever `volpath`'s output or this cache's layout changes.
 const TRUTH_VERSION: u32 = 1;
 
@@ -153,30 +157,6 @@ pub(crate) fn reference(
         100.0 * truth.noise()
     ));
     Ok(truth)
-}
-
-/// The pixels of `pixels` (ascending indices of a `width` × `height` image) whose eight
-/// neighbours are in `pixels` too (none on the image's border).
-pub(crate) fn interior(pixels: &[usize], width: u32, height: u32) -> Vec<usize> {
-    let (w, h) = (width as usize, height as usize);
-    let mut on = vec![false; w * h];
-    for &i in pixels {
-        if i < on.len() {
-            on[i] = true;
-        }
-    }
-    pixels
-        .iter()
-        .copied()
-        .filter(|&i| {
-            let (x, y) = (i % w, i / w);
-            x > 0
-                && y > 0
-                && x + 1 < w
-                && y + 1 < h
-                && (0..9).all(|k| on[(y + k / 3 - 1) * w + x + k % 3 - 1])
-        })
-        .collect()
 }
 
 /// The cache entry of `t`: a header line with the size, paths and seconds, the translucent

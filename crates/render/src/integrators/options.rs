@@ -71,6 +71,21 @@ impl MethodOptions {
         self.values.get(name).map(String::as_str)
     }
 
+    /// The options given that `method` takes, and the names of those it does not (which a
+    /// caller ignores with a warning, as `sss render` does another method's flag).
+    pub fn partition(&self, method: &Method) -> (MethodOptions, Vec<String>) {
+        let mut taken = MethodOptions::new();
+        let mut others = Vec::new();
+        for (name, value) in &self.values {
+            if method.options.iter().any(|o| o.name == name) {
+                taken.set(name, value);
+            } else {
+                others.push(name.clone());
+            }
+        }
+        (taken, others)
+    }
+
     /// Fails when an option given is not one of `method`'s.
     pub fn check_known(&self, method: &Method) -> Result<(), Error> {
         for name in self.names() {

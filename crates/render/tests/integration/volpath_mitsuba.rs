@@ -52,16 +52,8 @@ subdivisions = 5
 /// The pixels (row-major indices of a `w` × `h` image) whose 3 × 3 neighbourhood is fully
 /// covered by geometry: where both renderers' pixels mean the same thing.
 fn inside_silhouette(coverage: &[f32], w: usize, h: usize) -> Vec<usize> {
-    (0..w * h)
-        .filter(|&i| {
-            let (x, y) = (i % w, i / w);
-            x > 0
-                && y > 0
-                && x + 1 < w
-                && y + 1 < h
-                && (0..9).all(|k| coverage[(y + k / 3 - 1) * w + x + k % 3 - 1] == 1.0)
-        })
-        .collect()
+    let covered: Vec<usize> = (0..w * h).filter(|&i| coverage[i] == 1.0).collect();
+    sss_render::metrics::interior_pixels(&covered, w as u32, h as u32)
 }
 
 /// The interpreter with Mitsuba, or None (the test skips) when there is none and CI did not
