@@ -2,8 +2,8 @@
 //! only that the file exists. CI runs it after `cargo xtask compare --quick`.
 //!
 //! What must hold, from the physics and the conventions (`docs/compare.md`, `results.csv`):
-//! - every error figure is finite and non-negative, fractions lie in [0, 1], and no run gave
-//!   a warning (the built-in scenes are within every cap);
+//! - every error figure is finite and non-negative, fractions and FLIP lie in [0, 1], and no
+//!   run gave a warning (the built-in scenes are within every cap);
 //! - the same run with all threads and with one thread has identical error figures (renders
 //!   are bit-identical for any thread count);
 //! - unbiased methods agree with the reference on average: the path tracer at its largest
@@ -24,7 +24,9 @@
 //!   [`PATHTRACE_MIN_WITHIN_3SE`] of the pixels lie within 3 of their own standard errors of
 //!   the reference (measured 0.41–0.86 at 16 spp with `--quick`; an error bar understated by
 //!   √spp puts nearly every pixel outside). With 1 sample the error bar is 0 and the column is
-//!   0 by construction.
+//!   0 by construction;
+//! - the path tracer's HDR-FLIP (a file with the `flip` column) falls from 1 sample to its
+//!   largest sample count (less noise, less visible difference).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -59,6 +61,8 @@ pub struct Row {
     /// Empty for methods without standard errors.
     frac_within_3se: Option<f64>,
     mean_ratio: f64,
+    /// Absent from files written before the column existed.
+    flip: Option<f64>,
     warnings: usize,
 }
 
@@ -84,6 +88,7 @@ pub fn parse(text: &str) -> Result<Vec<Row>, String> {
         col("warnings")?,
         col("frac_within_3se")?,
     ];
+    let flip = header.iter().position(|h| *h == "flip");
     let mut rows = Vec::new();
     for (n, line) in lines.enumerate() {
         let f: Vec<&str> = line.split(',').collect();
@@ -108,6 +113,7 @@ pub fn parse(text: &str) -> Result<Vec<Row>, String> {
             rel_rmse: num(idx[5])?,
             frac_within_eps: num(idx[6])?,
             mean_ratio: num(idx[7])?,
+            flip: flip.map(num).transpose()?,
             warnings: num(idx[8])? as usize,
             frac_within_3se: if f[idx[9]].is_empty() {
                 None
@@ -139,6 +145,7 @@ pub fn check(rows: &[Row]) -> Vec<String> {
         if !finite
             || !fraction(r.frac_within_eps)
             || r.frac_within_3se.is_some_and(|v| !fraction(v))
+            || r.flip.is_some_and(|v| !fraction(v))
         {
             bad.push(format!("{}: a figure is out of range: {r:?}", name(r)));
         }
@@ -164,6 +171,7 @@ pub fn check(rows: &[Row]) -> Vec<String> {
                     r.frac_within_eps,
                     r.frac_within_3se,
                     r.mean_ratio,
+                    r.flip,
                 )
             };
             if figures(a) != figures(b) {
@@ -231,6 +239,14 @@ pub fn check(rows: &[Row]) -> Vec<String> {
                     bad.push(format!(
                         "{scene} pathtrace {}: mean ratio {} outside [{lo}, {hi}]",
                         last.value, last.mean_ratio
+                    ));
+                }
+                if let (true, Some(a), Some(b)) = (runs.len() > 1, first.flip, last.flip)
+                    && !(b < a)
+                {
+                    bad.push(format!(
+                        "{scene} pathtrace: FLIP {b} at {} spp is not below {a} at {} spp",
+                        last.value, first.value
                     ));
                 }
                 if runs.len() > 1 && last.rel_rmse >= PATHTRACE_CONVERGENCE * first.rel_rmse {
@@ -401,6 +417,35 @@ mod tests {
             let bad = check(&parse(&csv(&rows)).unwrap());
             assert!(!bad.is_empty(), "{line}: not caught");
             assert!(bad.iter().any(|b| b.contains(needle)), "{line}: {bad:?}");
+        }
+    }
+
+    /// With the `flip` column: a healthy sweep passes; FLIP above 1, FLIP differing between
+    /// thread counts and a path tracer whose FLIP does not fall are each caught.
+    #[test]
+    fn the_flip_column_is_checked_where_present() {
+        let with_flip = |flips: [&str; 8]| -> String {
+            let header = HEADER.replace(",warnings", ",flip,warnings");
+            let mut s = header;
+            for (row, f) in good().iter().zip(flips) {
+                let (head, warnings) = row.rsplit_once(',').unwrap();
+                s.push_str(&format!("\n{head},{f},{warnings}"));
+            }
+            s
+        };
+        let ok = ["0.2", "0.2", "0.1", "0.1", "0.5", "0.3", "0.1", "0.1"];
+        let rows = parse(&with_flip(ok)).unwrap();
+        assert_eq!(rows[4].flip, Some(0.5));
+        assert_eq!(check(&rows), Vec::<String>::new());
+        for (i, v, needle) in [
+            (6, "1.5", "out of range"),
+            (1, "0.21", "thread counts"),
+            (5, "0.5", "FLIP 0.5 at 16 spp is not below 0.5"),
+        ] {
+            let mut f = ok;
+            f[i] = v;
+            let bad = check(&parse(&with_flip(f)).unwrap());
+            assert!(bad.iter().any(|b| b.contains(needle)), "{i} {v}: {bad:?}");
         }
     }
 

@@ -179,6 +179,10 @@ struct CompareArgs {
     /// The reference cache [default: OUT/cache]; give shards one on a shared filesystem.
     #[arg(long, value_name = "DIR")]
     cache: Option<PathBuf>,
+    /// One exposure for every picture: linear values are multiplied by this scale before the
+    /// sRGB curve [default: per scene, its reference's automatic one, shared by every method].
+    #[arg(long, value_name = "SCALE", value_parser = sss_render::image::parse_exposure)]
+    exposure: Option<f64>,
 }
 
 fn workspace_root() -> PathBuf {
@@ -363,6 +367,7 @@ fn main() -> ExitCode {
                 merge: args.merge,
                 prepare: args.prepare,
                 cache: args.cache,
+                exposure: args.exposure,
             };
             compare::run(&config)
         }

@@ -14,7 +14,8 @@
 //!    `kernels` (the separable kernels) by default; `trees` and `manylight`, the paper-scale
 //!    experiments, and `truth` (every model against volumetric light transport), by their
 //!    flags.
-//! 3. `report.md` is assembled from the sections.
+//! 3. `report.md` is assembled from the sections, and `report.html` from it and the pictures
+//!    (module `html`: one self-contained page with image comparisons, FLIP maps and charts).
 //!
 //! Each experiment is a module of its own, split by concern (its plan, runs, scoring, plots
 //! or images, and report), and every CSV it writes goes through one writer (module `output`),
@@ -52,6 +53,7 @@
 
 mod checked;
 mod host;
+mod html;
 mod kernels;
 mod manylight;
 mod output;
@@ -123,6 +125,10 @@ pub struct Config {
     pub prepare: bool,
     /// The cache directory [default: `out/cache`].
     pub cache: Option<PathBuf>,
+    /// The exposure of every picture (`sss_render::image::write_png`'s scale), or `None` for
+    /// each scene's automatic one (its reference's); every method of a scene is drawn at its
+    /// reference's exposure either way.
+    pub exposure: Option<f64>,
 }
 
 impl Config {
@@ -147,6 +153,7 @@ impl Config {
             merge: Vec::new(),
             prepare: false,
             cache: None,
+            exposure: None,
         }
     }
 
@@ -401,6 +408,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
     );
     let path = config.out.join("report.md");
     write_atomic(&path, report.as_bytes())?;
+    html::write(&config.out, &report)?;
     eprintln!(
         "compare: done in {:.1} s; wrote {}",
         started.elapsed().as_secs_f64(),

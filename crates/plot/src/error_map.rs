@@ -4,48 +4,54 @@ use crate::PlotError;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// The "inferno"-like colour of t in [0, 1] (piecewise linear through 6 anchors of matplotlib's
-/// inferno map).
-pub fn false_colour(t: f64) -> [u8; 3] {
-    const ANCHORS: [[f64; 3]; 6] = [
-        [0.0, 0.0, 4.0],
-        [66.0, 10.0, 104.0],
-        [147.0, 38.0, 103.0],
-        [221.0, 81.0, 58.0],
-        [252.0, 165.0, 10.0],
-        [252.0, 255.0, 164.0],
-    ];
-    let t = if t.is_finite() {
-        t.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let x = t * 5.0;
-    let i = (x.floor() as usize).min(4);
-    let f = x - i as f64;
-    let mut c = [0u8; 3];
-    for k in 0..3 {
-        c[k] = (ANCHORS[i][k] * (1.0 - f) + ANCHORS[i + 1][k] * f).round() as u8;
-    }
-    c
+/// A perceptually uniform colour map of matplotlib (van der Walt, Smith & Firing), from
+/// `colorous`'s 256-entry tables (d3-scale-chromatic's, exact to 8 bits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ColourMap {
+    /// Black through purple and orange to pale yellow: the toolkit's error maps.
+    #[default]
+    Inferno,
+    /// Black through purple to pale pink: FLIP's maps, as NVIDIA draws them.
+    Magma,
+    /// Dark blue through green to yellow.
+    Viridis,
 }
 
-/// A diverging colour for t in [−1, 1]: blue (−1) through white (0) to red (+1), so that a
-/// signed difference reads at a glance (too dark is blue, too bright red).
+impl ColourMap {
+    /// The colour at t ∈ [0, 1] (clamped; a non-finite t is 0).
+    pub fn colour(self, t: f64) -> [u8; 3] {
+        let t = if t.is_finite() {
+            t.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let c = match self {
+            ColourMap::Inferno => colorous::INFERNO,
+            ColourMap::Magma => colorous::MAGMA,
+            ColourMap::Viridis => colorous::VIRIDIS,
+        }
+        .eval_continuous(t);
+        [c.r, c.g, c.b]
+    }
+}
+
+/// The inferno colour of t in [0, 1] ([`ColourMap::Inferno`]).
+pub fn false_colour(t: f64) -> [u8; 3] {
+    ColourMap::Inferno.colour(t)
+}
+
+/// A diverging colour for t in [−1, 1]: ColorBrewer's red-blue (Brewer, from `colorous`),
+/// blue at −1 through a light grey at 0 to red at +1, so that a signed difference reads at a
+/// glance (too dark is blue, too bright red).
 pub fn diverging_colour(t: f64) -> [u8; 3] {
     let t = if t.is_finite() {
         t.clamp(-1.0, 1.0)
     } else {
         0.0
     };
-    // White to (59, 76, 192) below zero, white to (180, 4, 38) above (the end colours of
-    // Moreland's cool-warm map).
-    let (end, f) = if t < 0.0 {
-        ([59.0, 76.0, 192.0], -t)
-    } else {
-        ([180.0, 4.0, 38.0], t)
-    };
-    [0, 1, 2].map(|k| (255.0 * (1.0 - f) + end[k] * f).round() as u8)
+    // colorous' RED_BLUE runs from red (0) to blue (1).
+    let c = colorous::RED_BLUE.eval_continuous(0.5 * (1.0 - t));
+    [c.r, c.g, c.b]
 }
 
 /// The colour of a value beyond a map's range (above `max`, or below `-max` on a signed
@@ -54,13 +60,16 @@ pub fn diverging_colour(t: f64) -> [u8; 3] {
 pub const OVER_RANGE: [u8; 3] = [0, 220, 0];
 
 /// How an unsigned map's values become colours: linear over [0, `max`], or with `log`
-/// logarithmic over [`max`·10⁻³, `max`] (three decades; smaller values at the bottom colour).
+/// logarithmic over [`max`·10⁻³, `max`] (three decades; smaller values at the bottom colour),
+/// through `colours`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MapScale {
     /// The top of the colour bar; larger values are drawn [`OVER_RANGE`].
     pub max: f64,
     /// Three decades on a log scale instead of a linear one.
     pub log: bool,
+    /// The colour map.
+    pub colours: ColourMap,
 }
 
 /// Decades a log-scaled map spans.
@@ -80,14 +89,14 @@ impl MapScale {
         usable_max(self.max)
     }
 
-    /// The colour of value `v` (non-negative): the inferno map at its position on the bar,
+    /// The colour of value `v` (non-negative): the colour map at its position on the bar,
     /// [`OVER_RANGE`] above `max`.
     pub fn colour(&self, v: f64) -> [u8; 3] {
         let max = self.max();
         if v > max {
             return OVER_RANGE;
         }
-        false_colour(self.position(v))
+        self.colours.colour(self.position(v))
     }
 
     /// Where `v` sits on the bar, 0 (bottom) to 1 (top).
@@ -126,7 +135,11 @@ pub fn write_error_map(
     title: &str,
     label: &str,
 ) -> Result<(), PlotError> {
-    let scale = MapScale { max, log: false };
+    let scale = MapScale {
+        max,
+        log: false,
+        colours: ColourMap::Inferno,
+    };
     write_error_map_with(path, width, height, values, &scale, title, label)
 }
 
@@ -148,7 +161,7 @@ pub fn write_error_map_with(
     };
     let map = Map {
         colour: &|v| scale.colour(v),
-        bar: &|t| false_colour(t),
+        bar: &|t| scale.colours.colour(t),
         tick: &|t| scale.value_at(t),
     };
     draw_map(&image, &map, title, label)
@@ -318,11 +331,16 @@ mod tests {
 
     #[test]
     fn the_diverging_map_is_white_at_zero_and_darkens_towards_each_end() {
-        assert_eq!(diverging_colour(0.0), [255, 255, 255]);
-        assert_eq!(diverging_colour(-1.0), [59, 76, 192]);
-        assert_eq!(diverging_colour(1.0), [180, 4, 38]);
+        // ColorBrewer's RdBu (11 classes) through d3's uniform B-spline: #053061 and #67001f
+        // at the ends; in the middle (#fddbc7 + 4·#f7f7f7 + #d1e5f0) / 6 = (241.7, 239.3,
+        // 237.8), truncated.
+        // Within 1 of each (the table's f32 arithmetic truncates).
+        let near = |a: [u8; 3], b: [u8; 3]| a.iter().zip(b).all(|(x, y)| x.abs_diff(y) <= 1);
+        assert!(near(diverging_colour(0.0), [241, 239, 237]));
+        assert!(near(diverging_colour(-1.0), [0x05, 0x30, 0x61]));
+        assert!(near(diverging_colour(1.0), [0x67, 0x00, 0x1f]));
         assert_eq!(diverging_colour(7.0), diverging_colour(1.0));
-        assert_eq!(diverging_colour(f64::NAN), [255, 255, 255]);
+        assert_eq!(diverging_colour(f64::NAN), diverging_colour(0.0));
         // Blue below zero, red above; farther from zero, farther from white.
         let sum = |c: [u8; 3]| c.iter().map(|&v| v as u32).sum::<u32>();
         let (a, b) = (diverging_colour(-0.3), diverging_colour(0.3));
@@ -331,10 +349,29 @@ mod tests {
     }
 
     #[test]
+    fn the_colour_maps_are_matplotlibs_tables() {
+        // The first and last entries of matplotlib's _cm_listed.py tables (×255, rounded).
+        assert_eq!(ColourMap::Inferno.colour(0.0), [0, 0, 4]);
+        assert_eq!(ColourMap::Inferno.colour(1.0), [252, 255, 164]);
+        assert_eq!(ColourMap::Magma.colour(0.0), [0, 0, 4]);
+        assert_eq!(ColourMap::Magma.colour(1.0), [252, 253, 191]);
+        assert_eq!(ColourMap::Viridis.colour(0.0), [68, 1, 84]);
+        assert_eq!(ColourMap::Viridis.colour(1.0), [253, 231, 37]);
+        // Viridis' middle entry (index 128 of 256: 0.127568, 0.566949, 0.550556).
+        let mid = ColourMap::Viridis.colour(128.0 / 255.0);
+        for (c, want) in mid.iter().zip([0.127568f64, 0.566949, 0.550556]) {
+            assert!((f64::from(*c) - 255.0 * want).abs() <= 1.0, "{mid:?}");
+        }
+        assert_eq!(ColourMap::Inferno.colour(f64::NAN), [0, 0, 4]);
+        assert_eq!(false_colour(2.0), ColourMap::Inferno.colour(1.0));
+    }
+
+    #[test]
     fn values_beyond_the_range_are_marked_and_the_log_scale_spans_three_decades() {
         let lin = MapScale {
             max: 0.2,
             log: false,
+            colours: ColourMap::Inferno,
         };
         assert_eq!(lin.colour(0.2), false_colour(1.0));
         assert_eq!(lin.colour(0.2000001), OVER_RANGE);
@@ -342,12 +379,15 @@ mod tests {
         // The marker is in neither map.
         for k in 0..=100 {
             let t = k as f64 / 100.0;
-            assert_ne!(false_colour(t), OVER_RANGE);
+            for map in [ColourMap::Inferno, ColourMap::Magma, ColourMap::Viridis] {
+                assert_ne!(map.colour(t), OVER_RANGE);
+            }
             assert_ne!(diverging_colour(2.0 * t - 1.0), OVER_RANGE);
         }
         let log = MapScale {
             max: 0.2,
             log: true,
+            colours: ColourMap::Magma,
         };
         assert!((log.position(0.2) - 1.0).abs() < 1e-12);
         assert!((log.position(0.02) - 2.0 / 3.0).abs() < 1e-12);
@@ -355,6 +395,7 @@ mod tests {
         assert_eq!(log.position(0.0002), 0.0);
         assert_eq!(log.position(0.0), 0.0);
         assert_eq!(log.colour(0.3), OVER_RANGE);
+        assert_eq!(log.colour(0.2), ColourMap::Magma.colour(1.0));
         for t in [0.0, 0.25, 0.5, 1.0] {
             assert!((log.position(log.value_at(t)) - t).abs() < 1e-12);
             assert!((lin.position(lin.value_at(t)) - t).abs() < 1e-12);
@@ -363,6 +404,7 @@ mod tests {
         let bad = MapScale {
             max: f64::NAN,
             log: false,
+            colours: ColourMap::Inferno,
         };
         assert_eq!(bad.colour(1.0), false_colour(1.0));
         assert_eq!(bad.colour(1.5), OVER_RANGE);

@@ -1,7 +1,8 @@
 //! # sss-plot: line plots and error maps for the toolkit's reports
 //!
-//! Line and scatter plots to PNG or SVG, for radial profiles and error reports, and
-//! false-colour per-pixel error maps ([`write_error_map`]). Use it when you want the pictures
+//! Line and scatter plots to PNG or SVG, for radial profiles and error reports, SVG charts for
+//! web pages whose points name themselves on hover ([`hover_svg`]), and false-colour per-pixel
+//! error maps ([`write_error_map`]). Use it when you want the pictures
 //! `sss` and `cargo xtask compare` draw; the renderer itself does not depend on it.
 //!
 //! The API is plain data: build [`Series`] (a name, points, a colour, an optional symmetric
@@ -30,7 +31,8 @@
 //! ```
 //!
 //! ## Papers
-//! None; the error-map colour ramp samples the inferno map (van der Walt & Smith, matplotlib).
+//! None. The colour maps are matplotlib's inferno, magma and viridis (van der Walt, Smith &
+//! Firing) and ColorBrewer's red-blue (Brewer), from the tables of the `colorous` crate.
 
 #![forbid(unsafe_code)]
 
@@ -42,10 +44,12 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 mod error_map;
+mod hover;
 pub use error_map::{
-    MapScale, OVER_RANGE, diverging_colour, false_colour, write_error_map, write_error_map_with,
-    write_signed_map,
+    ColourMap, MapScale, OVER_RANGE, diverging_colour, false_colour, write_error_map,
+    write_error_map_with, write_signed_map,
 };
+pub use hover::{LabelledSeries, escape_xml, hover_svg};
 
 /// A log y axis spans at most this many decades below its largest value.
 pub const MAX_LOG_DECADES: f64 = 10.0;

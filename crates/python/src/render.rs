@@ -326,7 +326,7 @@ fn diff_input(
 /// float32 or float64, or an EXR path (then `layer` is read, or for `ref` `reference_layer`
 /// when given: `"beauty"` for another renderer's plain R,G,B). Pixels where either image is
 /// positive are compared. Returns {"pixels", "rmse", "rel_rmse", "frac_within_eps",
-/// "mean_ratio" (float64 (3,))}.
+/// "mean_ratio" (float64 (3,)), "flip" (HDR-FLIP's mean over every pixel)}.
 #[pyfunction]
 #[pyo3(signature = (a, reference, *, layer="subsurface", reference_layer=None, eps=0.05))]
 pub fn diff<'py>(
@@ -358,10 +358,11 @@ pub fn diff<'py>(
     let pixels: Vec<usize> = (0..img.len())
         .filter(|&i| reference[i].iter().chain(img[i].iter()).any(|v| *v > 0.0))
         .collect();
-    let (f, ratio) = guard(|| {
+    let (f, ratio, flip) = guard(|| {
         Ok((
             error_figures(&img, &reference, &pixels, eps),
             mean_ratio_rgb(&img, &reference, &pixels),
+            sss_render::flip::hdr_flip(&img, &reference, w, h, &Default::default()).mean,
         ))
     })?;
     let clean = |v: f64| if v.is_finite() { v } else { 0.0 };
@@ -371,5 +372,6 @@ pub fn diff<'py>(
     d.set_item("rel_rmse", clean(f.rel_rmse))?;
     d.set_item("frac_within_eps", clean(f.frac_within_eps))?;
     d.set_item("mean_ratio", crate::arrays::rgb(py, ratio.map(clean))?)?;
+    d.set_item("flip", clean(flip))?;
     Ok(d)
 }

@@ -128,7 +128,8 @@ def test_diff_equals_sss_diff(small_scene, run_sss, tmp_path):
             np.testing.assert_allclose(got["rel_rmse"], expected["rel_rmse"][0], rtol=1e-5)
             np.testing.assert_allclose(got["frac_within_eps"], expected["frac_within_0.1"][0], atol=5e-5)
             np.testing.assert_allclose(got["mean_ratio"], expected["mean_ratio"], atol=5e-6)
-        assert expected["rmse"][0] > 0
+            np.testing.assert_allclose(got["flip"], expected["flip"][0], atol=5e-7)
+        assert expected["rmse"][0] > 0 and expected["flip"][0] > 0
     # Each side its own layer: `total` of a against `subsurface` of b, as `sss diff` does.
     expected = parse_diff(run_sss("diff", a, b, "--layer", "total", "--reference-layer", "subsurface"))
     got = sss.diff(a, b, layer="total", reference_layer="subsurface")
@@ -141,7 +142,7 @@ def test_diff_equals_sss_diff(small_scene, run_sss, tmp_path):
 def test_diff_of_an_image_with_itself_is_zero():
     img = np.random.default_rng(1).random((5, 7, 3)).astype(np.float32)
     d = sss.diff(img, img)
-    assert d["pixels"] == 35 and d["rmse"] == 0 and d["frac_within_eps"] == 1
+    assert d["pixels"] == 35 and d["rmse"] == 0 and d["frac_within_eps"] == 1 and d["flip"] == 0
     np.testing.assert_array_equal(d["mean_ratio"], [1, 1, 1])
 
 

@@ -471,6 +471,22 @@ fn srgb(v: f64) -> u8 {
     (s * 255.0 + 0.5).floor().clamp(0.0, 255.0) as u8
 }
 
+/// Parses an exposure (the `--exposure` of every command that writes PNGs): the scale each
+/// linear pixel value is multiplied by before the sRGB curve, a finite number > 0.
+pub fn parse_exposure(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "`{text}` is not an exposure: a finite scale > 0 (pixel values are multiplied by it)"
+        )),
+    }
+}
+
+/// `exposure`, or where it is `None` the automatic one of `pixels` ([`auto_exposure`]).
+pub fn exposure_or_auto(exposure: Option<f64>, pixels: &[Rgb]) -> f64 {
+    exposure.unwrap_or_else(|| auto_exposure(pixels))
+}
+
 /// A scale that maps the 99th percentile of the non-zero pixel luminances to 0.9 (1 if the
 /// image is black).
 pub fn auto_exposure(pixels: &[Rgb]) -> f64 {

@@ -77,6 +77,7 @@
 pub mod budget;
 pub mod camera;
 mod error;
+pub mod flip;
 pub mod frame;
 pub mod gbuffer;
 pub mod geometry;

@@ -1,13 +1,14 @@
 //! `sss diff`: error figures of one render against another (RMSE, relative RMSE, fraction of
-//! pixels within a relative error, mean ratio per channel; [`sss_render::metrics`]) and a
-//! false-colour error map.
+//! pixels within a relative error, mean ratio per channel; [`sss_render::metrics`]), HDR-FLIP
+//! ([`sss_render::flip`]), a false-colour error map and a FLIP map.
 
 use crate::commands::render::check_output;
 use crate::plot_error;
 use clap::Args;
 use sss_bssrdf::Rgb;
-use sss_plot::{MapScale, write_error_map_with};
+use sss_plot::{ColourMap, MapScale, write_error_map_with};
 use sss_render::Error;
+use sss_render::flip::{FlipParams, hdr_flip};
 use sss_render::image::{check_exr_budget, read_exr_within};
 use sss_render::metrics::{error_figures, mean_ratio_rgb, relative_errors};
 use std::path::{Path, PathBuf};
@@ -37,6 +38,10 @@ pub struct DiffArgs {
     /// The error map on a log scale: three decades below --range.
     #[arg(long)]
     pub log: bool,
+    /// HDR-FLIP's per-pixel error (Andersson et al. 2021; magma, 0 to 1) of the whole layer as
+    /// a PNG; its mean is the `flip` line either way.
+    #[arg(long, value_name = "FILE.png")]
+    pub flip_map: Option<PathBuf>,
     /// Relative-error threshold for the fraction of pixels within it.
     #[arg(long, default_value_t = 0.05)]
     pub eps: f64,
@@ -48,7 +53,7 @@ pub struct DiffArgs {
 
 /// Runs `sss diff`.
 pub fn run(args: &DiffArgs) -> Result<String, Error> {
-    if let Some(p) = &args.png {
+    for p in args.png.iter().chain(&args.flip_map) {
         check_output(p, "png")?;
     }
     if let Some(r) = args.range
@@ -107,6 +112,7 @@ pub fn run(args: &DiffArgs) -> Result<String, Error> {
         let scale = MapScale {
             max: args.range.unwrap_or(4.0 * args.eps),
             log: args.log,
+            colours: ColourMap::Inferno,
         };
         write_error_map_with(
             p,
@@ -123,9 +129,35 @@ pub fn run(args: &DiffArgs) -> Result<String, Error> {
         )
         .map_err(plot_error)?;
     }
+    // FLIP sees the whole picture, background included.
+    let flip = hdr_flip(
+        &img,
+        &reference,
+        w as usize,
+        h as usize,
+        &FlipParams::default(),
+    );
+    if let Some(p) = &args.flip_map {
+        let values: Vec<Option<f64>> = flip.map.iter().map(|&v| Some(f64::from(v))).collect();
+        let scale = MapScale {
+            max: 1.0,
+            log: false,
+            colours: ColourMap::Magma,
+        };
+        write_error_map_with(
+            p,
+            w,
+            h,
+            &values,
+            &scale,
+            &format!("HDR-FLIP, layer {} (mean {:.4})", args.layer, flip.mean),
+            "FLIP",
+        )
+        .map_err(plot_error)?;
+    }
     let ratio = mean_ratio_rgb(&img, &reference, &pixels);
     Ok(format!(
-        "pixels {}\nrmse {:.6e}\nrel_rmse {:.6e}\nfrac_within_{} {:.4}\nmean_ratio {:.5} {:.5} {:.5}\n",
+        "pixels {}\nrmse {:.6e}\nrel_rmse {:.6e}\nfrac_within_{} {:.4}\nmean_ratio {:.5} {:.5} {:.5}\nflip {:.6}\n",
         pixels.len(),
         f.rmse,
         f.rel_rmse,
@@ -133,6 +165,7 @@ pub fn run(args: &DiffArgs) -> Result<String, Error> {
         f.frac_within_eps,
         ratio[0],
         ratio[1],
-        ratio[2]
+        ratio[2],
+        flip.mean
     ))
 }

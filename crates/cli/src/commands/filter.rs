@@ -16,7 +16,7 @@ use crate::profile_table::build_medium;
 use clap::Args;
 use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_render::Error;
-use sss_render::image::{auto_exposure, read_exr_within, write_exr, write_png};
+use sss_render::image::{exposure_or_auto, read_exr_within, write_exr, write_png};
 use sss_render::integrators::separable::kernel_settings;
 use sss_render::kernel_choice::{MaterialKernel, build_kernel, filter_options};
 use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
@@ -48,6 +48,11 @@ pub struct FilterArgs {
     /// Tone-mapped PNG of the exitance.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
+    /// The PNG's exposure: linear values are multiplied by this scale before the sRGB curve
+    /// (values above 1 clip). Default: automatic, the 99th percentile of the non-zero
+    /// luminances to 0.9. Give the same value to compare PNGs of several renders.
+    #[arg(long, value_name = "SCALE", value_parser = sss_render::image::parse_exposure)]
+    pub exposure: Option<f64>,
     /// Run the pass on a GPU through wgpu (the exported WGSL compute shader). It has no
     /// jitter: needs `--jitter 0`. Needs an `sss` built with the `gpu` feature.
     #[arg(long)]
@@ -143,7 +148,7 @@ pub fn run(args: &FilterArgs) -> Result<String, Error> {
     let out: Vec<Rgb> = out.iter().map(|p| p.map(|v| v as f64)).collect();
     write_exr(&args.out, w, h, &[("exitance", &out)])?;
     if let Some(p) = &args.png {
-        write_png(p, w, h, &out, auto_exposure(&out))?;
+        write_png(p, w, h, &out, exposure_or_auto(args.exposure, &out))?;
     }
     let covered = mask.iter().filter(|m| **m != NO_OBJECT).count();
     Ok(format!(

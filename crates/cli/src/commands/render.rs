@@ -6,7 +6,7 @@ use crate::method_flags::{AllMethods, MethodFlags, method_parser};
 use clap::Args;
 use sss_bssrdf::Rgb;
 use sss_render::Error;
-use sss_render::image::{auto_exposure, write_exr, write_exr_with, write_png};
+use sss_render::image::{exposure_or_auto, write_exr, write_exr_with, write_png};
 use sss_render::integrators::{self, Integrator, MethodOptions};
 use sss_render::scene::{self, LoadOptions, Scene};
 use sss_render::{RenderOutput, RenderSettings, render};
@@ -52,6 +52,11 @@ pub struct RenderArgs {
     /// Tone-mapped sRGB PNG of the total.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
+    /// The PNG's exposure: linear values are multiplied by this scale before the sRGB curve
+    /// (values above 1 clip). Default: automatic, the 99th percentile of the non-zero
+    /// luminances to 0.9. Give the same value to compare PNGs of several renders.
+    #[arg(long, value_name = "SCALE", value_parser = sss_render::image::parse_exposure)]
+    pub exposure: Option<f64>,
     /// Also write the method's screen-space inputs (separable: layer `irradiance` as R,G,B,
     /// and `surface.R,G,B` = depth, footprint in scene units and object id + 1, 0 for none)
     /// for `sss filter`.
@@ -244,7 +249,7 @@ pub fn run(args: &RenderArgs) -> Result<String, Error> {
             out.width,
             out.height,
             &out.total,
-            auto_exposure(&out.total),
+            exposure_or_auto(args.exposure, &out.total),
         )?;
     }
     if let Some(p) = &args.gbuffer {

@@ -603,7 +603,27 @@ fn render_writes_exr_and_png_and_reports_stages() {
         reference.to_str().unwrap(),
     ]);
     assert!(same.contains("rmse 0.000000e0"), "{same}");
+    assert!(same.contains("\nflip 0.000000\n"), "{same}");
     assert!(std::fs::metadata(&err_png).unwrap().len() > 100);
+    // HDR-FLIP (checked against NVIDIA's flip-evaluator in sss-render's tests): in (0, 1) for
+    // a 4-spp render, and the map of it drawn.
+    let flip_png = dir.join("flip.png");
+    let with_map = ok(&[
+        "diff",
+        exr.to_str().unwrap(),
+        reference.to_str().unwrap(),
+        "--flip-map",
+        flip_png.to_str().unwrap(),
+    ]);
+    assert_eq!(with_map, diff, "the map changes no figure");
+    let flip: f64 = diff
+        .lines()
+        .find_map(|l| l.strip_prefix("flip "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(flip > 0.0 && flip < 1.0, "{diff}");
+    assert!(std::fs::metadata(&flip_png).unwrap().len() > 100);
 
     // The map's range: pixels beyond it are drawn in the over-range green (besides its
     // 20 × 14 swatch by the colour bar); a range above every error leaves only the swatch.
@@ -1429,4 +1449,72 @@ fn filter_and_diff_refuse_an_exr_whose_header_exceeds_the_budget() {
     let r = sss(&["diff", s, s, "--layer", "surface", "--max-memory", "575"]);
     assert_eq!(r.status.code(), Some(2), "{}", stderr(&r));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `--exposure SCALE` scales the PNG's linear values before the sRGB curve (IEC 61966-2-1),
+/// checked pixel by pixel against the EXR written beside it; a bad scale is refused by name.
+#[test]
+fn render_png_takes_one_exposure() {
+    let dir = tmp_dir("exposure");
+    let scene = tiny_scene(&dir);
+    let (exr, png_path) = (dir.join("e.exr"), dir.join("e.png"));
+    let srgb = |v: f64| {
+        let v = v.clamp(0.0, 1.0);
+        let s = if v <= 0.0031308 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        s * 255.0
+    };
+    for exposure in ["0.5", "3"] {
+        ok(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--method",
+            "separable",
+            "--out",
+            exr.to_str().unwrap(),
+            "--png",
+            png_path.to_str().unwrap(),
+            "--exposure",
+            exposure,
+        ]);
+        let (_, _, layers) = sss_render::image::read_exr(&exr).unwrap();
+        let total = &layers.iter().find(|(n, _)| n == "total").unwrap().1;
+        let decoder = png::Decoder::new(std::io::BufReader::new(
+            std::fs::File::open(&png_path).unwrap(),
+        ));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let step = info.color_type.samples();
+        let e: f64 = exposure.parse().unwrap();
+        let mut lit = 0;
+        for (p, px) in total.iter().zip(buf.chunks_exact(step)) {
+            for c in 0..3 {
+                let want = srgb(p[c] * e);
+                assert!(
+                    (f64::from(px[c]) - want).abs() <= 0.51,
+                    "exposure {e}: {} against {want}",
+                    px[c]
+                );
+                lit += usize::from(want > 10.0 && want < 245.0);
+            }
+        }
+        assert!(
+            lit > 30,
+            "exposure {e}: too few pixels between black and white"
+        );
+    }
+    let o = sss(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--png",
+        png_path.to_str().unwrap(),
+        "--exposure",
+        "0",
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("not an exposure"), "{}", stderr(&o));
 }

@@ -59,7 +59,7 @@ pub(super) fn edge_pictures(
 }
 
 /// The point-light response of material `name` (its better-dipole `model`) with the default
-/// kernel, with and without rotation jitter, under `dir`.
+/// kernel, with and without rotation jitter, under `dir`, at one exposure.
 pub(super) fn point_response(name: &str, model: &dyn Bssrdf, dir: &Path) -> Result<(), Error> {
     let p = Frame::point(TEST_SIDE);
     let k = match build_kernel(model, &SeparableSettings::default())
@@ -68,6 +68,8 @@ pub(super) fn point_response(name: &str, model: &dyn Bssrdf, dir: &Path) -> Resu
         MaterialKernel::Separable(k) => k,
         MaterialKernel::Full(_) => unreachable!("pre-integrated is separable"),
     };
+    // One exposure for the pair (the first's), so that they compare side by side.
+    let mut exposure = None;
     for (label, jitter) in [("no_jitter", 0.0f32), ("jitter", 1.0)] {
         let o = FilterOptions {
             jitter_radius: jitter,
@@ -75,12 +77,13 @@ pub(super) fn point_response(name: &str, model: &dyn Bssrdf, dir: &Path) -> Resu
         };
         let out = screen_space::filter(&p.input(), &k, &o).map_err(|e| Error(e.to_string()))?;
         let img = to_rgb(&out);
+        let e = *exposure.get_or_insert_with(|| auto_exposure(&img));
         write_png(
             &dir.join(format!("{name}_point_{label}.png")),
             TEST_SIDE as u32,
             TEST_SIDE as u32,
             &img,
-            auto_exposure(&img),
+            e,
         )
         .map_err(|e| Error(e.to_string()))?;
     }

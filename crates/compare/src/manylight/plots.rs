@@ -33,7 +33,7 @@ pub(super) fn pictures(
         let out = render(scene, &m, &settings, &NoProgress).map_err(e)?;
         if sel == Selection::BssrdfAware {
             let path = dir.join(format!("{}.png", scene.name));
-            let exposure = sss_render::image::auto_exposure(&out.total);
+            let exposure = sss_render::image::exposure_or_auto(ctx.config.exposure, &out.total);
             sss_render::image::write_png(&path, w, h, &out.total, exposure).map_err(e)?;
         }
         let t = out

@@ -11,8 +11,8 @@
 //!
 //! Writes `results.csv` (one row per run and thread count; columns documented in
 //! `docs/compare.md`), `error_vs_time_<scene>.png` (log-log RMSE against total seconds), and
-//! under `scenes/<scene>/` the reference, each method's most expensive render and its
-//! false-colour error map.
+//! under `scenes/<scene>/` the reference, each method's most expensive render, its
+//! false-colour error map and its HDR-FLIP map.
 
 mod cache;
 mod images;
@@ -38,7 +38,8 @@ use images::write_images;
 use runs::{Outcome, results_csv, run_timed};
 use sss_plot::{PALETTE, Series, SeriesStyle, line_plot};
 use sss_render::RenderSettings;
-use sss_render::image::{auto_exposure, write_png};
+use sss_render::flip::{FlipMap, FlipParams, hdr_flip};
+use sss_render::image::{exposure_or_auto, write_png};
 use sss_render::integrators::exact::reference_spacing;
 use sss_render::integrators::{Converges, METHODS, Method, MethodOptions};
 use sss_render::metrics::{error_figures, frac_within_se, mean_ratio};
@@ -70,6 +71,12 @@ impl Experiment for SceneComparison {
     }
 }
 
+/// A unit's FLIP: computed on its first run, taken from it by the others.
+enum FlipOfUnit {
+    Known(f64),
+    Map(FlipMap),
+}
+
 /// A scene made ready for its units: the reference, the pixels scored, the exposure of its
 /// pictures and their directory.
 struct Prepared {
@@ -89,7 +96,7 @@ fn prepare(ctx: &Context<'_>, scene: &Scene, text: &str) -> Result<Prepared, Err
     let dir = ctx.config.out.join("scenes").join(&scene.name);
     std::fs::create_dir_all(&dir)
         .map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
-    let exposure = auto_exposure(&reference.subsurface);
+    let exposure = exposure_or_auto(ctx.config.exposure, &reference.subsurface);
     let e = |e: sss_render::Error| Error(e.to_string());
     write_png(
         &dir.join("reference.png"),
@@ -104,7 +111,7 @@ fn prepare(ctx: &Context<'_>, scene: &Scene, text: &str) -> Result<Prepared, Err
         scene.camera.width,
         scene.camera.height,
         &reference.total,
-        auto_exposure(&reference.total),
+        exposure_or_auto(ctx.config.exposure, &reference.total),
     )
     .map_err(e)?;
     Ok(Prepared {
@@ -172,7 +179,7 @@ pub(super) fn run_units(
         } else {
             &[all_threads]
         };
-        let mut runs = Vec::new();
+        let mut runs: Vec<Run> = Vec::new();
         let mut why_not = None;
         for &threads in counts {
             let label = format!("{} {}={v}", m.name, m.sweep.label);
@@ -201,13 +208,27 @@ pub(super) fn run_units(
             let reference = &prepared.reference.subsurface;
             let pixels = &prepared.pixels;
             let f = error_figures(&out.subsurface, reference, pixels, EPS);
-            if threads == all_threads && unit.value + 1 == values.len() {
+            // A unit's runs give the same image whatever their threads: FLIP once.
+            let flip = match runs.first() {
+                Some(first) => FlipOfUnit::Known(first.flip),
+                None => FlipOfUnit::Map(hdr_flip(
+                    &out.subsurface,
+                    reference,
+                    out.width as usize,
+                    out.height as usize,
+                    &FlipParams::default(),
+                )),
+            };
+            if threads == all_threads
+                && unit.value + 1 == values.len()
+                && let FlipOfUnit::Map(map) = &flip
+            {
                 write_images(
                     &prepared.dir,
                     &format!("{}_{}", m.name, v),
                     &out,
-                    reference,
-                    pixels,
+                    (reference, pixels),
+                    &map.map,
                     prepared.exposure,
                 )?;
             }
@@ -227,6 +248,10 @@ pub(super) fn run_units(
                     .as_ref()
                     .and_then(|se| frac_within_se(&out.subsurface, se, reference, pixels, 3.0)),
                 mean_ratio: mean_ratio(&out.subsurface, reference, pixels),
+                flip: match &flip {
+                    FlipOfUnit::Known(v) => *v,
+                    FlipOfUnit::Map(map) => map.mean,
+                },
                 warnings: out.warnings.clone(),
             });
         }

@@ -113,6 +113,7 @@ pub(crate) fn assemble(
                     md_pct(Some(r.frac_within_eps)),
                     md_pct(r.within_3se),
                     md_num(Some(r.mean_ratio), 4),
+                    md_num(Some(r.flip), 3),
                 ];
                 if mixed {
                     let h = hosts.iter().position(|h| **h == r.host).unwrap_or(0);
@@ -133,6 +134,7 @@ pub(crate) fn assemble(
             &within,
             "within 3 SE",
             "mean / ref. mean",
+            "FLIP",
         ];
         if mixed {
             header.push("host");

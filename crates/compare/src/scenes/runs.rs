@@ -51,6 +51,9 @@ pub struct Run {
     /// Mean over translucent pixels and channels of the render divided by the reference's
     /// (1 for an unbiased method, up to noise).
     pub mean_ratio: f64,
+    /// HDR-FLIP of the subsurface image against the reference's, the mean over the whole
+    /// frame (`sss_render::flip`; the background agrees, so it counts as 0).
+    pub flip: f64,
     /// Warnings the render gave (a cap that bound, implausible units).
     pub warnings: Vec<String>,
 }
@@ -94,6 +97,7 @@ pub fn csv_columns(stages: &[&str]) -> Vec<String> {
             "frac_within_eps",
             "frac_within_3se",
             "mean_ratio",
+            "flip",
             "warnings",
         ]
         .map(String::from),
@@ -123,6 +127,7 @@ pub fn results_csv(runs: &[Run]) -> Csv {
             csv_num(Some(r.frac_within_eps)),
             csv_num(r.within_3se),
             csv_num(Some(r.mean_ratio)),
+            csv_num(Some(r.flip)),
             csv_text(r.warnings.len()),
         ]);
         csv.row(row);
@@ -200,8 +205,8 @@ fn stage_name(name: &str) -> &'static str {
 impl Run {
     /// The run as one line of tab-separated fields (no line break): scene, method, param,
     /// value, threads, host, host cores, stages (`name=seconds` joined by `;`), rmse, relative
-    /// RMSE, fraction within ε, fraction within 3 SE (empty for none), mean ratio, then one
-    /// field per warning. Numbers in round-trip notation: [`Run::from_record`] gives the run
+    /// RMSE, fraction within ε, fraction within 3 SE (empty for none), mean ratio, FLIP, then
+    /// one field per warning. Numbers in round-trip notation: [`Run::from_record`] gives the run
     /// back bit for bit.
     pub fn record(&self) -> String {
         let stages: Vec<String> = self
@@ -223,6 +228,7 @@ impl Run {
             num(self.frac_within_eps),
             opt_num(self.within_3se),
             num(self.mean_ratio),
+            num(self.flip),
         ];
         fields.extend(self.warnings.iter().map(|w| escape(w)));
         fields.join("\t")
@@ -232,8 +238,8 @@ impl Run {
     /// name and sweep label are taken from `METHODS`).
     pub fn from_record(line: &str) -> Result<Run, String> {
         let f: Vec<&str> = line.split('\t').collect();
-        if f.len() < 13 {
-            return Err(format!("{} fields, at least 13 expected", f.len()));
+        if f.len() < 14 {
+            return Err(format!("{} fields, at least 14 expected", f.len()));
         }
         let text = |i: usize| unescape(f[i]).ok_or_else(|| format!("field {}: bad escape", i + 1));
         let number = |i: usize| {
@@ -290,7 +296,8 @@ impl Run {
                 Some(number(11)?)
             },
             mean_ratio: number(12)?,
-            warnings: (13..f.len()).map(text).collect::<Result<_, _>>()?,
+            flip: number(13)?,
+            warnings: (14..f.len()).map(text).collect::<Result<_, _>>()?,
         })
     }
 }
@@ -347,6 +354,7 @@ mod tests {
             frac_within_eps: 1.0,
             within_3se: None,
             mean_ratio: 1.0,
+            flip: 0.0,
             warnings: Vec::new(),
         }
     }
@@ -431,6 +439,7 @@ mod tests {
         r.rel_rmse = f64::MIN_POSITIVE;
         r.within_3se = Some(0.7);
         r.mean_ratio = 1.0 + f64::EPSILON;
+        r.flip = 0.1 + 0.7;
         r.stages[2].seconds = 1e-300;
         r.host.cpu = "cpu, with comma\tand tab".into();
         r.warnings = vec!["cap bound\t(spacing 2)".into(), String::new(), "\\n".into()];
@@ -444,6 +453,7 @@ mod tests {
         assert_eq!(back.rmse.to_bits(), r.rmse.to_bits());
         assert_eq!(back.rel_rmse.to_bits(), r.rel_rmse.to_bits());
         assert_eq!(back.mean_ratio.to_bits(), r.mean_ratio.to_bits());
+        assert_eq!(back.flip.to_bits(), r.flip.to_bits());
         assert_eq!(back.within_3se, r.within_3se);
         assert_eq!(back.host, r.host);
         assert_eq!(back.warnings, r.warnings);
@@ -464,11 +474,12 @@ mod tests {
         assert!(with(3, "x").contains("field 4"));
         assert!(with(4, "-1").contains("not a count"));
         assert!(with(7, "bvh").contains("name=seconds"));
+        assert!(with(13, "flip").contains("field 14"));
         assert!(with(0, "bad\\q").contains("bad escape"));
         assert!(
             Run::from_record("a\tb")
                 .unwrap_err()
-                .contains("at least 13")
+                .contains("at least 14")
         );
         for text in ["", "plain", "\\", "\t\n\r\\\\t"] {
             assert_eq!(unescape(&escape(text)).as_deref(), Some(text));

@@ -34,6 +34,7 @@ fn results(units: &[SweepUnit], hosts: &[Host]) -> Vec<UnitResult> {
                 frac_within_eps: 0.5,
                 within_3se: None,
                 mean_ratio: 1.0,
+                flip: 0.0,
                 warnings: Vec::new(),
             };
             if m.name == "eelc" {

@@ -35,6 +35,10 @@ pub(super) fn settings(config: &Config, outline: &PlanOutline) -> Vec<(&'static 
         ("format", FORMAT.to_string()),
         ("version", version()),
         ("quick", config.quick.to_string()),
+        (
+            "exposure",
+            config.exposure.map_or("auto".into(), |e| format!("{e:e}")),
+        ),
         ("seed", config.seed.to_string()),
         ("photons", config.photons.to_string()),
         ("bins", config.bins.to_string()),
@@ -135,8 +139,8 @@ pub(super) fn read_manifest(dir: &Path) -> Result<Manifest, Error> {
         .map_err(|e| Error(format!("{}: {e}", path.display())))?;
     let seconds = get("seconds")?.parse().unwrap_or(f64::NAN);
     let keys = [
-        "format", "version", "quick", "seed", "photons", "bins", "presets", "scenes", "loaded",
-        "skipped", "units",
+        "format", "version", "quick", "exposure", "seed", "photons", "bins", "presets", "scenes",
+        "loaded", "skipped", "units",
     ];
     let settings = keys
         .iter()
@@ -221,6 +225,10 @@ pub(super) fn merged_config(m: &Manifest, out: &Path) -> Result<Config, Error> {
         seed: get("seed").parse().map_err(|_| bad("seed"))?,
         bins: get("bins").parse().map_err(|_| bad("bins"))?,
         quick: get("quick").parse().map_err(|_| bad("quick"))?,
+        exposure: match get("exposure").as_str() {
+            "auto" => None,
+            e => Some(e.parse().map_err(|_| bad("exposure"))?),
+        },
         ..Config::new(list("presets")?, list("scenes")?, out.to_path_buf())
     })
 }

@@ -208,6 +208,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
     );
     let path = out.join("report.md");
     write_atomic(&path, report.as_bytes())?;
+    crate::html::write(out, &report)?;
     eprintln!("merge: {} shards -> {}", manifests.len(), path.display());
     Ok(())
 }

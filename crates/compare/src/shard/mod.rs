@@ -46,7 +46,7 @@ use std::str::FromStr;
 use std::time::Instant;
 
 /// Version of the shard files' layout; bump when it changes.
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 /// The manifest's file name.
 const MANIFEST: &str = "shard.txt";

@@ -198,6 +198,14 @@ fn shards_merge_to_the_unsharded_run() {
     let whole_report = std::fs::read_to_string(base.out.join("report.md")).unwrap();
     assert_eq!(headings(&report), headings(&whole_report));
     assert!(report.contains("Merged from 3 shards"), "{report}");
+    // report.html: the same viewers, pictures and chart points either way (timings differ).
+    let html = |d: &Path| std::fs::read_to_string(d.join("report.html")).unwrap();
+    let (hw, hm) = (html(&base.out), html(&merged));
+    for pat in ["<section class=\"viewer\"", "<img", "<circle", "<table>"] {
+        assert_eq!(hw.matches(pat).count(), hm.matches(pat).count(), "{pat}");
+    }
+    assert!(hm.matches("<section class=\"viewer\"").count() >= 1);
+    assert!(hm.contains("Merged from 3 shards"));
 
     // Refusals.
     let merge = |dirs: Vec<PathBuf>| {

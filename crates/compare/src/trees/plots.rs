@@ -20,7 +20,7 @@ pub(super) fn pictures(ctx: &Context<'_>, runs: &[TreeRun], res: u32) -> Result<
     else {
         return Ok(());
     };
-    let exposure = sss_render::image::auto_exposure(&finest.out.subsurface);
+    let exposure = sss_render::image::exposure_or_auto(ctx.config.exposure, &finest.out.subsurface);
     let covered: Vec<bool> = finest.out.coverage.iter().map(|&c| c > 0.0).collect();
     let difference = |r: &TreeRun| -> Vec<Option<f64>> {
         r.out

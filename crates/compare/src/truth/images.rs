@@ -8,17 +8,18 @@ use super::*;
 pub const SIGNED_RANGE: f64 = 0.5;
 
 /// Writes `truth/<case>/reference.png`, `<model>.png` and `<model>_difference.png` for every
-/// model image.
+/// model image, at `exposure` (`None`: the reference's automatic one).
 pub(crate) fn write_pictures(
     dir: &Path,
     case: &str,
     truth: &Truth,
     models: &[(&'static str, Vec<Rgb>)],
+    exposure: Option<f64>,
 ) -> Result<(), Error> {
     std::fs::create_dir_all(dir)
         .map_err(|e| Error(format!("cannot create {}: {e}", dir.display())))?;
     let (w, h) = (truth.width, truth.height);
-    let exposure = auto_exposure(&truth.image);
+    let exposure = exposure.unwrap_or_else(|| auto_exposure(&truth.image));
     let png = |name: &str, px: &[Rgb]| {
         write_png(&dir.join(name), w, h, px, exposure).map_err(|e| Error(e.to_string()))
     };

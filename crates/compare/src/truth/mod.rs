@@ -114,6 +114,7 @@ impl Experiment for TruthExperiment {
                 &name,
                 &truth,
                 &runs.model_images,
+                cfg.exposure,
             )?;
             write_plot(
                 &cfg.out.join(format!("truth_error_vs_time_{name}.png")),

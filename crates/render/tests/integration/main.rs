@@ -9,6 +9,7 @@ mod common;
 mod disk_average;
 mod dual_tree_fmm;
 mod exr_budget;
+mod flip_evaluator;
 mod fuzz_regressions;
 mod integrator_contract;
 mod manylight;

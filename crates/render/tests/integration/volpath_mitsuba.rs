@@ -8,7 +8,8 @@
 //! camera samples where Mitsuba's box filter averages the whole pixel, which differs at the
 //! silhouette by more than either image's path noise.
 
-use sss_peers::{MitsubaRun, RR_NEVER, export, find_python, mitsuba_subsurface, render_mitsuba};
+use super::common::peers_python;
+use sss_peers::{MitsubaRun, RR_NEVER, export, mitsuba_subsurface, render_mitsuba};
 use sss_render::integrators::{self, MethodOptions};
 use sss_render::progress::NoProgress;
 use sss_render::scene::{LoadOptions, load_str};
@@ -56,22 +57,6 @@ fn inside_silhouette(coverage: &[f32], w: usize, h: usize) -> Vec<usize> {
     sss_render::metrics::interior_pixels(&covered, w as u32, h as u32)
 }
 
-/// The interpreter with Mitsuba, or None (the test skips) when there is none and CI did not
-/// ask for it.
-fn peers_python() -> Option<std::path::PathBuf> {
-    match find_python(&["mitsuba", "numpy"]) {
-        Ok(p) => Some(p),
-        Err(why) => {
-            assert!(
-                std::env::var_os("SSS_REQUIRE_PEERS").is_none(),
-                "SSS_REQUIRE_PEERS is set but {why}"
-            );
-            eprintln!("skipped: {why}");
-            None
-        }
-    }
-}
-
 /// Mitsuba runs without its Russian roulette, whose weights are heavy-tailed (its mean
 /// converges from below: at 32 × 512 samples its green and blue were 0.2–0.4 % low, 2σ;
 /// `docs/peers.md`). Measured at 4 × 4 096 paths per pixel against 32 × 512 samples: image
@@ -79,7 +64,9 @@ fn peers_python() -> Option<std::path::PathBuf> {
 /// from 32 batches inflates E[z²] by about 31/29).
 #[test]
 fn volpath_equals_mitsuba_within_both_images_noise() {
-    let Some(python) = peers_python() else { return };
+    let Some(python) = peers_python(&["mitsuba", "numpy"]) else {
+        return;
+    };
     let scene = load_str(SCENE, "peer-sphere.toml", None, &LoadOptions::default()).unwrap();
     let method = integrators::build("volpath", &MethodOptions::new().with("spp", 1024)).unwrap();
     let ours = render(
@@ -151,7 +138,9 @@ fn volpath_equals_mitsuba_within_both_images_noise() {
 /// error about 0.1 %); 0.9999 at 1 024.
 #[test]
 fn opaque_radiometry_matches_mitsuba() {
-    let Some(python) = peers_python() else { return };
+    let Some(python) = peers_python(&["mitsuba", "numpy"]) else {
+        return;
+    };
     let text = SCENE.replace(
         "preset = \"skin1\"\nunits_per_mm = 1.0",
         "preset = \"skin1\"\nunits_per_mm = 1.0\n\n[materials.grey]\ntype = \"diffuse\"\nalbedo = 0.5",

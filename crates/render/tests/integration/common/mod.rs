@@ -179,3 +179,20 @@ pub fn diffuse() -> Material {
         },
     }
 }
+
+/// A Python that imports `modules` (`SSS_PEERS_PYTHON`, else `python3`), or None with the
+/// reason printed (the test skips) — unless `SSS_REQUIRE_PEERS` is set, as in CI, where a
+/// missing package fails the test.
+pub fn peers_python(modules: &[&str]) -> Option<std::path::PathBuf> {
+    match sss_peers::find_python(modules) {
+        Ok(p) => Some(p),
+        Err(why) => {
+            assert!(
+                std::env::var_os("SSS_REQUIRE_PEERS").is_none(),
+                "SSS_REQUIRE_PEERS is set but {why}"
+            );
+            eprintln!("skipped: {why}");
+            None
+        }
+    }
+}

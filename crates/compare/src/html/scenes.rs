@@ -1,0 +1,385 @@
+//! What the page shows of each scene, read from the output directory: the pictures under
+//! `scenes/<scene>/` and the runs of `results.csv`.
+
+use super::super::Error;
+use super::data_uri;
+use sss_plot::{LabelledSeries, hover_svg};
+use std::path::Path;
+
+/// One run of `results.csv`: the columns the page shows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub scene: String,
+    pub method: String,
+    pub param: String,
+    pub value: f64,
+    pub threads: usize,
+    pub seconds: f64,
+    pub rel_rmse: f64,
+    pub frac_within_eps: f64,
+    pub mean_ratio: f64,
+    /// Absent in files without the column.
+    pub flip: Option<f64>,
+}
+
+/// The rows of `results.csv` text; rows that do not parse are left out (the page shows what
+/// it can; `cargo xtask check-results` judges the file).
+pub fn parse_results(text: &str) -> Vec<Row> {
+    let mut lines = text.lines();
+    let Some(header) = lines.next() else {
+        return Vec::new();
+    };
+    let header: Vec<&str> = header.split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name);
+    let (
+        Some(scene),
+        Some(method),
+        Some(param),
+        Some(value),
+        Some(threads),
+        Some(seconds),
+        Some(rel),
+        Some(within),
+        Some(ratio),
+    ) = (
+        col("scene"),
+        col("method"),
+        col("param"),
+        col("value"),
+        col("threads"),
+        col("seconds_total"),
+        col("rel_rmse"),
+        col("frac_within_eps"),
+        col("mean_ratio"),
+    )
+    else {
+        return Vec::new();
+    };
+    let flip = col("flip");
+    lines
+        .filter_map(|line| {
+            let f: Vec<&str> = line.split(',').collect();
+            if f.len() != header.len() {
+                return None;
+            }
+            let num = |i: usize| f[i].parse::<f64>().ok();
+            Some(Row {
+                scene: f[scene].to_string(),
+                method: f[method].to_string(),
+                param: f[param].to_string(),
+                value: num(value)?,
+                threads: f[threads].parse().ok()?,
+                seconds: num(seconds)?,
+                rel_rmse: num(rel)?,
+                frac_within_eps: num(within)?,
+                mean_ratio: num(ratio)?,
+                flip: flip.and_then(num),
+            })
+        })
+        .collect()
+}
+
+/// One method's pictures and figures in a scene's viewer.
+#[derive(Clone, Debug, Default)]
+pub struct MethodView {
+    /// `method param=value`.
+    pub label: String,
+    /// Data URIs of the method's image, signed error map, relative error map and FLIP map.
+    pub image: Option<String>,
+    pub signed: Option<String>,
+    pub error: Option<String>,
+    pub flip: Option<String>,
+    /// Its run with the most threads, where `results.csv` has it.
+    pub row: Option<Row>,
+}
+
+/// One scene's viewer.
+#[derive(Clone, Debug, Default)]
+pub struct Viewer {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    /// Data URI of the reference picture.
+    pub reference: String,
+    pub methods: Vec<MethodView>,
+    /// The hardest region: x, y, width, height in pixels.
+    pub crop: Option<[u32; 4]>,
+    /// SVG charts (error and FLIP against time).
+    pub charts: Vec<String>,
+}
+
+/// An 8-bit RGB picture decoded from a PNG (RGB or RGBA, 8 bits), or `None`.
+pub fn decode_rgb(path: &Path) -> Option<(u32, u32, Vec<[u8; 3]>)> {
+    let file = std::fs::File::open(path).ok()?;
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .ok()?;
+    let mut buf = vec![0; reader.output_buffer_size()?];
+    let info = reader.next_frame(&mut buf).ok()?;
+    if info.bit_depth != png::BitDepth::Eight {
+        return None;
+    }
+    let step = match info.color_type {
+        png::ColorType::Rgb => 3,
+        png::ColorType::Rgba => 4,
+        _ => return None,
+    };
+    let px = buf[..info.buffer_size()]
+        .chunks_exact(step)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    Some((info.width, info.height, px))
+}
+
+/// The window of a quarter of each side (at least 8 pixels, at most the picture) where the
+/// pictures differ most from the reference, summed over pictures and channels; `None` when
+/// no picture matches the reference's size or none differs.
+pub fn hardest_region(
+    reference: &(u32, u32, Vec<[u8; 3]>),
+    others: &[Vec<[u8; 3]>],
+) -> Option<[u32; 4]> {
+    let (w, h, r) = reference;
+    let (w, h) = (*w as usize, *h as usize);
+    let n = w * h;
+    let others: Vec<&Vec<[u8; 3]>> = others.iter().filter(|o| o.len() == n).collect();
+    if n == 0 || others.is_empty() {
+        return None;
+    }
+    // Summed-area table of the per-pixel difference.
+    let mut sat = vec![0u64; (w + 1) * (h + 1)];
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let d: u64 = others
+                .iter()
+                .map(|o| {
+                    (0..3)
+                        .map(|c| u64::from(o[i][c].abs_diff(r[i][c])))
+                        .sum::<u64>()
+                })
+                .sum();
+            sat[(y + 1) * (w + 1) + x + 1] =
+                d + sat[y * (w + 1) + x + 1] + sat[(y + 1) * (w + 1) + x] - sat[y * (w + 1) + x];
+        }
+    }
+    let (cw, ch) = ((w / 4).max(8).min(w), (h / 4).max(8).min(h));
+    let mut best: Option<(u64, [u32; 4])> = None;
+    for y in 0..=h - ch {
+        for x in 0..=w - cw {
+            let s = sat[(y + ch) * (w + 1) + x + cw] + sat[y * (w + 1) + x]
+                - sat[y * (w + 1) + x + cw]
+                - sat[(y + ch) * (w + 1) + x];
+            if best.is_none_or(|(b, _)| s > b) {
+                best = Some((s, [x as u32, y as u32, cw as u32, ch as u32]));
+            }
+        }
+    }
+    best.filter(|(s, _)| *s > 0).map(|(_, c)| c)
+}
+
+/// The value of a picture's file name as `results.csv` writes it (`{}` of the f64).
+fn file_value(v: f64) -> String {
+    format!("{v}")
+}
+
+/// The viewers of every scene with a `scenes/<scene>/reference.png`, in the order of
+/// `results.csv` (then by name); each method in the order of its first run.
+pub fn viewers(out: &Path) -> Result<Vec<Viewer>, Error> {
+    let dir = out.join("scenes");
+    let rows = std::fs::read_to_string(out.join("results.csv"))
+        .map(|t| parse_results(&t))
+        .unwrap_or_default();
+    let mut names: Vec<String> = Vec::new();
+    for r in &rows {
+        if !names.contains(&r.scene) {
+            names.push(r.scene.clone());
+        }
+    }
+    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .filter(|e| e.path().is_dir())
+                .filter_map(|e| e.file_name().to_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    on_disk.sort();
+    for n in on_disk {
+        if !names.contains(&n) {
+            names.push(n);
+        }
+    }
+    let mut viewers = Vec::new();
+    for scene in names {
+        let sdir = dir.join(&scene);
+        let Some(reference) = decode_rgb(&sdir.join("reference.png")) else {
+            continue;
+        };
+        let Some(reference_uri) = data_uri(&sdir.join("reference.png")) else {
+            continue;
+        };
+        let runs: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
+        // The methods with pictures: each `<method>_<value>_flip.png` or `_error.png`.
+        let mut stems: Vec<String> = std::fs::read_dir(&sdir)
+            .map(|d| {
+                d.filter_map(|e| e.ok())
+                    .filter_map(|e| e.file_name().to_str().map(String::from))
+                    .filter_map(|f| {
+                        f.strip_suffix("_error.png")
+                            .or_else(|| f.strip_suffix("_flip.png"))
+                            .map(String::from)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        stems.sort();
+        stems.dedup();
+        let first_run = |stem: &str| {
+            runs.iter()
+                .position(|r| format!("{}_{}", r.method, file_value(r.value)) == stem)
+                .unwrap_or(usize::MAX)
+        };
+        stems.sort_by_key(|s| first_run(s));
+        let mut pictures = Vec::new();
+        let mut methods = Vec::new();
+        for stem in &stems {
+            let row = runs
+                .iter()
+                .filter(|r| format!("{}_{}", r.method, file_value(r.value)) == *stem)
+                .max_by_key(|r| r.threads)
+                .map(|r| (*r).clone());
+            let label = row.as_ref().map_or(stem.clone(), |r| {
+                format!("{} {}={}", r.method, r.param, file_value(r.value))
+            });
+            let file = |suffix: &str| data_uri(&sdir.join(format!("{stem}{suffix}.png")));
+            if let Some((w, h, px)) = decode_rgb(&sdir.join(format!("{stem}.png")))
+                && (w, h) == (reference.0, reference.1)
+            {
+                pictures.push(px);
+            }
+            methods.push(MethodView {
+                label,
+                image: file(""),
+                signed: file("_signed"),
+                error: file("_error"),
+                flip: file("_flip"),
+                row,
+            });
+        }
+        let crop = hardest_region(&reference, &pictures);
+        viewers.push(Viewer {
+            scene: scene.clone(),
+            width: reference.0,
+            height: reference.1,
+            reference: reference_uri,
+            methods,
+            crop,
+            charts: charts(&scene, &runs),
+        });
+    }
+    Ok(viewers)
+}
+
+/// The scene's relative RMSE and FLIP against run time (runs with the most threads), one
+/// series per method, each point labelled with its run.
+fn charts(scene: &str, runs: &[&Row]) -> Vec<String> {
+    let threads = runs.iter().map(|r| r.threads).max().unwrap_or(0);
+    let mut methods: Vec<&str> = Vec::new();
+    for r in runs {
+        if !methods.contains(&r.method.as_str()) {
+            methods.push(&r.method);
+        }
+    }
+    let series = |y: &dyn Fn(&Row) -> Option<f64>| -> Vec<LabelledSeries> {
+        methods
+            .iter()
+            .map(|m| LabelledSeries {
+                name: m.to_string(),
+                points: runs
+                    .iter()
+                    .filter(|r| r.method == *m && r.threads == threads)
+                    .filter_map(|r| {
+                        let v = y(r)?;
+                        let label = format!(
+                            "{} {}={}: {:.3} s, rel. RMSE {:.3} %, FLIP {}, mean ratio {:.4}",
+                            r.method,
+                            r.param,
+                            file_value(r.value),
+                            r.seconds,
+                            100.0 * r.rel_rmse,
+                            r.flip.map_or("–".into(), |f| format!("{f:.4}")),
+                            r.mean_ratio
+                        );
+                        Some((r.seconds, v, label))
+                    })
+                    .collect(),
+                color: None,
+            })
+            .collect()
+    };
+    let mut out = vec![hover_svg(
+        &format!("{scene}: relative RMSE against time ({threads} threads)"),
+        "seconds",
+        "relative RMSE",
+        &series(&|r| Some(r.rel_rmse)),
+        true,
+        true,
+    )];
+    if runs.iter().any(|r| r.flip.is_some()) {
+        out.push(hover_svg(
+            &format!("{scene}: HDR-FLIP against time ({threads} threads)"),
+            "seconds",
+            "mean HDR-FLIP",
+            &series(&|r| r.flip),
+            true,
+            true,
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn results_parse_by_column_name() {
+        let text = "scene,method,param,value,threads,seconds_total,rel_rmse,frac_within_eps,mean_ratio,flip,warnings\n\
+                    s,exact,spacing_mfp,2e0,2,1.5e0,1e-1,5e-1,1e0,2e-2,0\n\
+                    s,exact,spacing_mfp,bad,2,1,1,1,1,1,0\n\
+                    s,pathtrace,spp,1.6e1,1,3e0,2e-1,1e-1,9.9e-1,,0\n";
+        let rows = parse_results(text);
+        assert_eq!(rows.len(), 2);
+        assert_eq!(rows[0].value, 2.0);
+        assert_eq!(rows[0].flip, Some(0.02));
+        assert_eq!(rows[1].flip, None);
+        assert_eq!(file_value(rows[1].value), "16");
+        assert_eq!(file_value(0.05), "0.05");
+        assert!(parse_results("no,columns\n1,2\n").is_empty());
+    }
+
+    #[test]
+    fn the_hardest_region_is_where_pictures_differ() {
+        let (w, h) = (40u32, 32u32);
+        let reference = (w, h, vec![[100u8; 3]; (w * h) as usize]);
+        let mut a = reference.2.clone();
+        // A bright patch at (28..34, 20..26).
+        for y in 20..26 {
+            for x in 28..34 {
+                a[(y * w + x) as usize] = [200, 100, 100];
+            }
+        }
+        let c = hardest_region(&reference, &[a.clone()]).unwrap();
+        assert_eq!((c[2], c[3]), (10, 8));
+        // The window holds the whole 6 × 6 patch.
+        assert!(
+            c[0] <= 28 && c[0] + c[2] >= 34 && c[1] <= 20 && c[1] + c[3] >= 26,
+            "{c:?}"
+        );
+        assert_eq!(
+            hardest_region(&reference, std::slice::from_ref(&reference.2)),
+            None
+        );
+        assert_eq!(hardest_region(&reference, &[vec![[0; 3]; 3]]), None);
+    }
+}
