@@ -39,9 +39,10 @@ def main(source_path, dom_path, console_path):
     for line in console.splitlines():
         if "CONSOLE" in line and ("ERROR" in line or "Uncaught" in line):
             bad.append("console: " + line.strip())
+    verdict = "all loaded" if not bad else "NOT all loaded"
     print(
-        f"check_dom: {want_images} pictures, {want_charts} charts, {want_points} points "
-        f"loaded; {len(source) / 1e6:.1f} MB"
+        f"check_dom: {want_images} pictures, {want_charts} charts, {want_points} chart points "
+        f"in the file ({len(source) / 1e6:.1f} MB): {verdict}"
     )
     return bad
 

@@ -2,8 +2,51 @@
 //! through, and number formatting for the report.
 
 use super::Error;
+use sss_plot::{LabelledSeries, Series, hover_svg, line_plot};
 use std::fmt::Display;
 use std::path::Path;
+
+/// A number with 4 significant digits, for a point's hover label.
+fn short(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-3..1e5).contains(&v.abs()) {
+        format!("{v:.3e}")
+    } else {
+        format!("{v:.4}")
+    }
+}
+
+/// Draws `series` as the PNG `path` ([`sss_plot::line_plot`]) and, beside it with the
+/// extension `.svg`, the same chart for `report.html`, each point naming its series and
+/// coordinates on hover ([`sss_plot::hover_svg`]). For the plots of error against time.
+pub fn plot_with_hover(
+    path: &Path,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[Series],
+    (log_x, log_y): (bool, bool),
+) -> Result<(), Error> {
+    let name = path.display();
+    line_plot(path, title, x_label, y_label, series, log_x, log_y)
+        .map_err(|e| Error(format!("{name}: {e}")))?;
+    let labelled: Vec<LabelledSeries> = series
+        .iter()
+        .map(|s| LabelledSeries {
+            name: s.name.clone(),
+            points: s
+                .points
+                .iter()
+                .map(|&(x, y)| {
+                    let label =
+                        format!("{}: {x_label} {}, {y_label} {}", s.name, short(x), short(y));
+                    (x, y, label)
+                })
+                .collect(),
+            color: s.color,
+        })
+        .collect();
+    let svg = hover_svg(title, x_label, y_label, &labelled, log_x, log_y);
+    write_atomic(&path.with_extension("svg"), svg.as_bytes())
+}
 
 /// Writes `bytes` to a temporary file next to `path` and renames it into place, so a reader
 /// never sees a half-written file (`sss_util::write_atomic`).

@@ -32,10 +32,12 @@ pub fn escape_xml(text: &str) -> String {
     out
 }
 
-/// Size of a chart in SVG user units.
+/// Size of a chart's plot area and axes in SVG user units (the legend adds its width).
 const SIZE: (f64, f64) = (640.0, 400.0);
-/// Left, right, top and bottom margins (axis labels, legend).
+/// Left, right (without the legend's text), top and bottom margins.
 const MARGIN: (f64, f64, f64, f64) = (70.0, 150.0, 30.0, 50.0);
+/// Width of a legend character at the 12-unit font, generously.
+const CHAR_W: f64 = 7.0;
 
 /// An axis: its range and where a value lands on it.
 struct Axis {
@@ -61,8 +63,9 @@ impl Axis {
         }
     }
 
-    /// Tick values: each power of ten on a log axis (every other one beyond 8 decades), five
-    /// even steps on a linear one.
+    /// Tick values: each power of ten on a log axis (every other one beyond 8 decades; 2 and
+    /// 5 times each too where fewer than three powers fall in the range), five even steps on
+    /// a linear one.
     fn ticks(&self) -> Vec<f64> {
         if self.log {
             let (a, b) = (
@@ -70,7 +73,15 @@ impl Axis {
                 self.hi.log10().floor() as i32,
             );
             let step = if b - a > 8 { 2 } else { 1 };
-            (a..=b).step_by(step).map(|e| 10f64.powi(e)).collect()
+            let decades: Vec<f64> = (a..=b).step_by(step).map(|e| 10f64.powi(e)).collect();
+            if decades.len() >= 3 {
+                return decades;
+            }
+            let e0 = self.lo.log10().floor() as i32;
+            (e0..=b.max(e0) + 1)
+                .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
+                .filter(|v| *v >= self.lo && *v <= self.hi)
+                .collect()
         } else {
             (0..=4)
                 .map(|k| self.lo + (self.hi - self.lo) * k as f64 / 4.0)
@@ -116,9 +127,15 @@ pub fn hover_svg(
     let all = || kept.iter().flatten();
     let xa = Axis::new(all().map(|p| p.0), log_x);
     let ya = Axis::new(all().map(|p| p.1), log_y);
-    let (w, h) = SIZE;
     let (ml, mr, mt, mb) = MARGIN;
-    let (pw, ph) = (w - ml - mr, h - mt - mb);
+    let legend = series
+        .iter()
+        .map(|s| s.name.chars().count())
+        .max()
+        .unwrap_or(0) as f64
+        * CHAR_W;
+    let (pw, ph) = (SIZE.0 - ml - mr, SIZE.1 - mt - mb);
+    let (w, h) = (SIZE.0 + (legend - (mr - 40.0)).max(0.0), SIZE.1);
     let px = |x: f64| ml + xa.at(x) * pw;
     let py = |y: f64| mt + (1.0 - ya.at(y)) * ph;
     let mut s = String::new();
@@ -256,9 +273,27 @@ mod tests {
         for &(x, y) in &circles {
             assert!(x >= ml && x <= SIZE.0 - mr && y >= mt && y <= SIZE.1 - mb);
         }
+        // Room for the legend's longest name.
+        let long = LabelledSeries {
+            name: "x".repeat(60),
+            points: vec![(1.0, 1.0, "p".into())],
+            color: None,
+        };
+        let wide = hover_svg("t", "x", "y", &[long], false, false);
+        let want = format!("viewBox=\"0 0 {} 400\"", SIZE.0 + 60.0 * CHAR_W - 110.0);
+        assert!(wide.contains(&want), "{wide}");
         assert!(circles[0].0 < circles[1].0 && circles[0].1 < circles[1].1);
-        // Decade ticks on a log axis.
+        // Decade ticks on a log axis; 2 and 5 times them where fewer than three decades show.
         assert!(svg.contains(">1e-2<") && svg.contains(">1e1<"), "{svg}");
+        let narrow = LabelledSeries {
+            name: "n".into(),
+            points: vec![(1.0, 0.3, "a".into()), (2.0, 4.0, "b".into())],
+            color: None,
+        };
+        let svg = hover_svg("t", "x", "y", &[narrow], false, true);
+        for t in [">5e-1<", ">1e0<", ">2e0<"] {
+            assert!(svg.contains(t), "{t}: {svg}");
+        }
     }
 
     #[test]

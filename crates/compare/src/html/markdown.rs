@@ -1,8 +1,9 @@
 //! The Markdown `report.md` is written in, as HTML: headings, paragraphs, pipe tables, `- `
 //! lists, `code`, *emphasis*, **strong** and images. That subset is all the report uses; any
 //! other line is a paragraph's text, escaped, so nothing in the report can inject markup.
-//! Images are handed to `image`, which returns the `src` to use (a data URI) or `None` for a
-//! file that is not there (then the alternative text is shown instead of a broken image).
+//! Images are handed to `image` with their alternative text, which returns the markup to
+//! show (a picture inlined) or `None` for a file that is not there (then the alternative text
+//! is shown instead of a broken image).
 
 use sss_plot::escape_xml;
 use std::fmt::Write as _;
@@ -21,7 +22,7 @@ pub fn slug(text: &str) -> String {
 }
 
 /// Inline markup of one escaped line: `code`, **strong**, *emphasis*, and ![alt](file).
-fn inline(text: &str, image: &mut dyn FnMut(&str) -> Option<String>) -> String {
+fn inline(text: &str, image: &mut Images<'_>) -> String {
     let mut out = String::new();
     let mut rest = text;
     while !rest.is_empty() {
@@ -35,15 +36,8 @@ fn inline(text: &str, image: &mut dyn FnMut(&str) -> Option<String>) -> String {
             && let Some(end) = r[mid..].find(')')
         {
             let (alt, file) = (&r[..mid], &r[mid + 2..mid + end]);
-            match image(file) {
-                Some(src) => {
-                    let _ = write!(
-                        out,
-                        "<img src=\"{}\" alt=\"{}\" class=\"figure\">",
-                        escape_xml(&src),
-                        escape_xml(alt)
-                    );
-                }
+            match image(file, alt) {
+                Some(markup) => out.push_str(&markup),
                 None => {
                     let _ = write!(
                         out,
@@ -91,19 +85,21 @@ fn is_rule(line: &str) -> bool {
             .all(|c| !c.is_empty() && c.chars().all(|ch| matches!(ch, '-' | ':')))
 }
 
+/// How an image (its file, its alternative text) becomes markup.
+pub type Images<'a> = dyn FnMut(&str, &str) -> Option<String> + 'a;
+
 /// `markdown` as HTML, images through `image`.
-pub fn to_html(markdown: &str, image: &mut dyn FnMut(&str) -> Option<String>) -> String {
+pub fn to_html(markdown: &str, image: &mut Images<'_>) -> String {
     let lines: Vec<&str> = markdown.lines().collect();
     let mut out = String::new();
     let mut i = 0;
     let mut para: Vec<&str> = Vec::new();
-    let flush =
-        |para: &mut Vec<&str>, out: &mut String, image: &mut dyn FnMut(&str) -> Option<String>| {
-            if !para.is_empty() {
-                let _ = writeln!(out, "<p>{}</p>", inline(&para.join(" "), image));
-                para.clear();
-            }
-        };
+    let flush = |para: &mut Vec<&str>, out: &mut String, image: &mut Images<'_>| {
+        if !para.is_empty() {
+            let _ = writeln!(out, "<p>{}</p>", inline(&para.join(" "), image));
+            para.clear();
+        }
+    };
     while i < lines.len() {
         let line = lines[i];
         let t = line.trim_start();
@@ -166,8 +162,8 @@ mod tests {
     use super::*;
 
     fn html(md: &str) -> String {
-        to_html(md, &mut |f: &str| {
-            (f == "a.png").then(|| "data:image/png;base64,AA".into())
+        to_html(md, &mut |f: &str, alt: &str| {
+            (f == "a.png").then(|| format!("<img src=\"data:image/png;base64,AA\" alt=\"{alt}\">"))
         })
     }
 

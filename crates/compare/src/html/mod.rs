@@ -7,7 +7,9 @@
 //! (where the methods' pictures differ most from the reference), zoomable; each method's
 //! signed error and HDR-FLIP maps; its figures under the image and in a table; the error and
 //! FLIP against run time as SVG charts whose points name their run on hover. Then report.md
-//! as HTML, its tables and plots included.
+//! as HTML, its tables and plots included, and every other plot at the top of the directory;
+//! a PNG plot with an SVG beside it (`output::plot_with_hover`: every experiment's error
+//! against time) is shown as that chart, its points labelled on hover.
 //!
 //! The page checks itself as it loads: `<body>` gets `data-ready`, `data-images` (how many
 //! pictures), `data-broken` (how many failed to decode), `data-charts`, `data-points` and
@@ -55,18 +57,65 @@ pub fn data_uri(path: &Path) -> Option<String> {
     Some(format!("data:{mime};base64,{}", base64(&bytes)))
 }
 
-/// Writes `out/report.html` from `report` (the text of `report.md`) and the files under `out`.
+/// The markup of the picture `path` (with `alt` text): the SVG chart beside a PNG plot inlined
+/// where there is one (its points label themselves on hover), else the picture as a data
+/// URI; `None` when neither can be read.
+fn picture(path: &Path, alt: &str) -> Option<String> {
+    let svg = path.with_extension("svg");
+    if path.extension().is_some_and(|e| e == "png")
+        && let Ok(text) = std::fs::read_to_string(&svg)
+        && text.starts_with("<svg ")
+    {
+        return Some(text.replacen("<svg ", "<svg class=\"chart\" ", 1));
+    }
+    let src = data_uri(path)?;
+    Some(format!(
+        "<img src=\"{}\" alt=\"{}\" class=\"figure\">",
+        sss_plot::escape_xml(&src),
+        sss_plot::escape_xml(alt)
+    ))
+}
+
+/// Writes `out/report.html` from `report` (the text of `report.md`) and the files under `out`:
+/// the scenes' viewers, the report, then every plot at the top of `out` the report does not
+/// show (the error-against-time plots of each experiment among them), except the scenes'
+/// `error_vs_time_<scene>.png`, whose charts the viewers draw.
 pub fn write(out: &Path, report: &str) -> Result<(), Error> {
     let viewers = scenes::viewers(out)?;
-    let mut image = |file: &str| {
+    let mut shown: Vec<String> = viewers
+        .iter()
+        .map(|v| format!("error_vs_time_{}.png", v.scene))
+        .collect();
+    let mut image = |file: &str, alt: &str| {
         // Only files inside the output directory (the report's own).
         let rel = Path::new(file);
         if rel.is_absolute() || rel.components().any(|c| c.as_os_str() == "..") {
             return None;
         }
-        data_uri(&out.join(rel))
+        shown.push(file.to_string());
+        picture(&out.join(rel), alt)
     };
-    let body = markdown::to_html(report, &mut image);
+    let mut body = markdown::to_html(report, &mut image);
+    let mut rest: Vec<String> = std::fs::read_dir(out)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .filter_map(|e| e.file_name().to_str().map(String::from))
+                .filter(|f| f.ends_with(".png") && !shown.contains(f))
+                .collect()
+        })
+        .unwrap_or_default();
+    rest.sort();
+    if !rest.is_empty() {
+        body.push_str("<h2 id=\"every-plot\">Every other plot of this run</h2>\n");
+        for f in &rest {
+            if let Some(p) = picture(&out.join(f), f) {
+                body.push_str(&format!(
+                    "<figure>{p}<figcaption><code>{}</code></figcaption></figure>\n",
+                    sss_plot::escape_xml(f)
+                ));
+            }
+        }
+    }
     let html = page::page(&viewers, &body);
     write_atomic(&out.join("report.html"), html.as_bytes())
 }
@@ -90,5 +139,37 @@ mod tests {
             assert_eq!(base64(plain.as_bytes()), coded);
         }
         assert_eq!(base64(&[0xff, 0xfe, 0xfd]), "//79");
+    }
+
+    /// The page of a directory with no scenes: the report's own plot once, the other plots in
+    /// the gallery (the chart of a plot with an SVG beside it inlined, a plain PNG as a
+    /// picture), and a path out of the directory refused.
+    #[test]
+    fn every_plot_of_the_directory_is_shown_once() {
+        let dir = std::env::temp_dir().join(format!("sss-html-gallery-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let png = |name: &str| {
+            sss_render::image::write_png_rgb8(&dir.join(name), 2, 1, &[255, 0, 0, 0, 0, 255])
+                .unwrap()
+        };
+        png("in_report.png");
+        png("with_chart.png");
+        png("plain.png");
+        std::fs::write(
+            dir.join("with_chart.svg"),
+            "<svg viewBox=\"0 0 1 1\"><circle/></svg>",
+        )
+        .unwrap();
+        let report = "# R\n\n![ours](in_report.png)\n\n![outside](../x.png)\n";
+        write(&dir, report).unwrap();
+        let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+        assert_eq!(html.matches("alt=\"ours\"").count(), 1);
+        assert!(html.contains("<figcaption><code>plain.png</code>"));
+        assert!(!html.contains("<code>in_report.png</code>"), "shown once");
+        assert!(html.contains("<svg class=\"chart\" viewBox=\"0 0 1 1\"><circle/></svg>"));
+        assert!(html.contains("[outside — ../x.png not found]"));
+        // Two pictures, the report's and the plain one: the charted PNG is shown as its chart.
+        assert_eq!(html.matches("<img ").count(), 2, "{html}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -131,16 +131,13 @@ pub(super) fn plots(
         true,
     )
     .map_err(|e| Error(e.to_string()))?;
-    line_plot(
+    crate::output::plot_with_hover(
         &out.join("kernel_error_vs_time.png"),
         &format!(
             "Separable kernels: rel. RMSE vs exact 2D against {fw}x{fh} frame time ({all_threads} threads)"
         ),
-        "seconds per frame",
-        "relative RMSE",
+        ("seconds per frame", "relative RMSE"),
         curves,
-        true,
-        true,
+        (true, true),
     )
-    .map_err(|e| Error(e.to_string()))
 }

@@ -221,16 +221,13 @@ pub(super) fn plots(ctx: &Context<'_>, rows: &[Row], p: &Plan) -> Result<(), Err
             });
         }
         let file = format!("manylight_rmse_{name}.png");
-        line_plot(
+        crate::output::plot_with_hover(
             &out.join(&file),
             &format!("{name}: RMSE against time on the subset (frame set-up included)"),
-            "seconds",
-            "RMSE",
+            ("seconds", "RMSE"),
             &series,
-            true,
-            true,
-        )
-        .map_err(|e| Error(format!("{file}: {e}")))?;
+            (true, true),
+        )?;
     }
     let vp: Vec<(f64, f64)> = rows
         .iter()

@@ -137,14 +137,11 @@ pub(super) fn plot_error_vs_cost(
                 .with_style(SeriesStyle::Markers)
         })
         .collect();
-    sss_plot::line_plot(
+    crate::output::plot_with_hover(
         &ctx.config.out.join("error_vs_cost.png"),
         "Relative L2 error against cost (one point per preset and channel)",
-        "ns per Rd evaluation",
-        "relative L2 error vs Monte Carlo",
+        ("ns per Rd evaluation", "relative L2 error vs Monte Carlo"),
         &series,
-        true,
-        true,
+        (true, true),
     )
-    .map_err(|e| Error(e.to_string()))
 }

@@ -168,19 +168,16 @@ pub(super) fn plots(ctx: &Context<'_>, runs: &[TreeRun], p: &Plan) -> Result<(),
             .with_style(SeriesStyle::LineMarkers)
             .with_color(PALETTE[4]),
     ];
-    line_plot(
+    crate::output::plot_with_hover(
         &out.join("trees_error_vs_time.png"),
         &format!(
             "bunny {0}x{0}: RMSE against exact (subset) vs. total time",
             p.sweep_resolution
         ),
-        "seconds (total)",
-        "RMSE",
+        ("seconds (total)", "RMSE"),
         &series,
-        true,
-        true,
-    )
-    .map_err(pe)?;
+        (true, true),
+    )?;
     let scaling = |method: &str| -> Vec<(f64, f64)> {
         let mut v: Vec<(f64, f64)> = runs
             .iter()

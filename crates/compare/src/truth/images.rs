@@ -117,14 +117,11 @@ pub(crate) fn write_plot(path: &Path, case: &str, runs: &[TruthRun]) -> Result<(
             );
         }
     }
-    line_plot(
+    crate::output::plot_with_hover(
         path,
         &format!("{case}: error against volpath's reference vs. time"),
-        "seconds (total)",
-        "relative RMSE",
+        ("seconds (total)", "relative RMSE"),
         &series,
-        true,
-        true,
+        (true, true),
     )
-    .map_err(|e| Error(e.to_string()))
 }

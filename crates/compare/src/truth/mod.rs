@@ -46,7 +46,7 @@ use report::{CaseResult, section, truth_csv};
 use runs::{EXACT_SAMPLES, FAST, FAST_MODEL, PATHTRACE_SPP, TruthRun, run_case};
 use scoring::{Crossover, Score, score, score_without_noise};
 use sss_bssrdf::{Medium, ModelKind, Rgb};
-use sss_plot::{PALETTE, Series, SeriesStyle, line_plot, write_signed_map};
+use sss_plot::{PALETTE, Series, SeriesStyle, write_signed_map};
 use sss_render::image::{auto_exposure, write_png};
 use sss_render::integrators::exact::{Exact, reference_spacing};
 use sss_render::integrators::pathtrace::PathTrace;
