@@ -14,6 +14,9 @@
 //! The page checks itself as it loads: `<body>` gets `data-ready`, `data-images` (how many
 //! pictures), `data-broken` (how many failed to decode), `data-charts`, `data-points` and
 //! `data-errors` (script errors), which the browser test (`tests/browser/`) reads.
+//!
+//! The truth experiment's cases get viewers too (`truth/<case>/`: the `volpath` reference and
+//! each model's `exact` image with its signed difference; figures from `truth.csv`).
 
 mod markdown;
 mod page;
@@ -81,7 +84,8 @@ fn picture(path: &Path, alt: &str) -> Option<String> {
 /// show (the error-against-time plots of each experiment among them), except the scenes'
 /// `error_vs_time_<scene>.png`, whose charts the viewers draw.
 pub fn write(out: &Path, report: &str) -> Result<(), Error> {
-    let viewers = scenes::viewers(out)?;
+    let mut viewers = scenes::viewers(out)?;
+    viewers.extend(scenes::truth_viewers(out));
     let mut shown: Vec<String> = viewers
         .iter()
         .map(|v| format!("error_vs_time_{}.png", v.scene))

@@ -154,12 +154,12 @@ fn viewer(v: &Viewer) -> String {
     let _ = write!(
         s,
         "<section class=\"viewer\" id=\"scene-{id}\"><h2>{}</h2>\
-         <p>{}×{} pixels. The reference (<code>exact</code>) and every method's most expensive \
-         run at one exposure (the reference's). Drag the slider: reference left, method right; \
-         click a method or a row of the table.</p><div class=\"buttons\">",
+         <p>{}×{} pixels. {} Drag the slider: reference left, method right; click a method or \
+         a row of the table.</p><div class=\"buttons\">",
         escape_xml(&v.scene),
         v.width,
-        v.height
+        v.height,
+        v.about
     );
     for (i, m) in v.methods.iter().enumerate() {
         let _ = write!(
@@ -347,6 +347,7 @@ mod tests {
         let uri = |k: &str| Some(format!("data:image/png;base64,{k}"));
         let v = Viewer {
             scene: "s <1>".into(),
+            about: "About.".into(),
             width: 40,
             height: 20,
             reference: "data:image/png;base64,REF".into(),

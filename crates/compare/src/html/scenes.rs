@@ -97,6 +97,8 @@ pub struct MethodView {
 #[derive(Clone, Debug, Default)]
 pub struct Viewer {
     pub scene: String,
+    /// What the reference is and what the methods are, one sentence for the reader.
+    pub about: String,
     pub width: u32,
     pub height: u32,
     /// Data URI of the reference picture.
@@ -269,6 +271,9 @@ pub fn viewers(out: &Path) -> Result<Vec<Viewer>, Error> {
         let crop = hardest_region(&reference, &pictures);
         viewers.push(Viewer {
             scene: scene.clone(),
+            about: "The reference (<code>exact</code>) and every method's most expensive run \
+                    at one exposure (the reference's)."
+                .into(),
             width: reference.0,
             height: reference.1,
             reference: reference_uri,
@@ -278,6 +283,148 @@ pub fn viewers(out: &Path) -> Result<Vec<Viewer>, Error> {
         });
     }
     Ok(viewers)
+}
+
+/// The rows of `truth.csv` text as the page shows them: each model's `exact` image of a case
+/// (`scene` is the case, `method` the model; `frac_within_eps` unknown, NaN).
+pub fn parse_truth(text: &str) -> Vec<Row> {
+    let mut lines = text.lines();
+    let Some(header) = lines.next() else {
+        return Vec::new();
+    };
+    let header: Vec<&str> = header.split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name);
+    let cols = [
+        "case",
+        "renderer",
+        "method",
+        "model",
+        "threads",
+        "seconds",
+        "rel_rmse",
+        "mean_ratio_r",
+        "mean_ratio_g",
+        "mean_ratio_b",
+    ]
+    .map(col);
+    let Some(
+        [
+            case,
+            renderer,
+            method,
+            model,
+            threads,
+            seconds,
+            rel,
+            r,
+            g,
+            b,
+        ],
+    ) = cols
+        .iter()
+        .copied()
+        .collect::<Option<Vec<usize>>>()
+        .and_then(|v| <[usize; 10]>::try_from(v).ok())
+    else {
+        return Vec::new();
+    };
+    lines
+        .filter_map(|line| {
+            let f: Vec<&str> = line.split(',').collect();
+            if f.len() != header.len() || f[renderer] != "sss" || f[method] != "exact" {
+                return None;
+            }
+            let num = |i: usize| f[i].parse::<f64>().ok();
+            Some(Row {
+                scene: f[case].to_string(),
+                method: f[model].to_string(),
+                param: String::new(),
+                value: 0.0,
+                threads: f[threads].parse().ok()?,
+                seconds: num(seconds)?,
+                rel_rmse: num(rel)?,
+                frac_within_eps: f64::NAN,
+                mean_ratio: (num(r)? + num(g)? + num(b)?) / 3.0,
+                flip: None,
+            })
+        })
+        .collect()
+}
+
+/// The viewers of the truth experiment's cases (`truth/<case>/`: `reference.png`, the
+/// `volpath` reference, and each model's `exact` image `<model>.png` with its signed
+/// difference `<model>_difference.png`), figures from `truth.csv`.
+pub fn truth_viewers(out: &Path) -> Vec<Viewer> {
+    let dir = out.join("truth");
+    let rows = std::fs::read_to_string(out.join("truth.csv"))
+        .map(|t| parse_truth(&t))
+        .unwrap_or_default();
+    let mut cases: Vec<String> = std::fs::read_dir(&dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .filter(|e| e.path().join("reference.png").is_file())
+                .filter_map(|e| e.file_name().to_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    cases.sort();
+    let mut viewers = Vec::new();
+    for case in cases {
+        let cdir = dir.join(&case);
+        let (Some(reference), Some(reference_uri)) = (
+            decode_rgb(&cdir.join("reference.png")),
+            data_uri(&cdir.join("reference.png")),
+        ) else {
+            continue;
+        };
+        let mut models: Vec<String> = std::fs::read_dir(&cdir)
+            .map(|d| {
+                d.filter_map(|e| e.ok())
+                    .filter_map(|e| e.file_name().to_str().map(String::from))
+                    .filter_map(|f| f.strip_suffix("_difference.png").map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default();
+        models.sort();
+        let mut pictures = Vec::new();
+        let methods = models
+            .iter()
+            .map(|m| {
+                let path = cdir.join(format!("{m}.png"));
+                if let Some((w, h, px)) = decode_rgb(&path)
+                    && (w, h) == (reference.0, reference.1)
+                {
+                    pictures.push(px);
+                }
+                MethodView {
+                    label: format!("exact, {m}"),
+                    image: data_uri(&path),
+                    signed: data_uri(&cdir.join(format!("{m}_difference.png"))),
+                    error: None,
+                    flip: None,
+                    row: rows
+                        .iter()
+                        .find(|r| r.scene == case && r.method == *m)
+                        .cloned(),
+                }
+            })
+            .collect();
+        viewers.push(Viewer {
+            scene: case.clone(),
+            about: "Real light transport against every model: the reference is \
+                    <code>volpath</code> (volumetric path tracing of the medium), each model is \
+                    rendered by <code>exact</code>, all at the reference's exposure; the map is \
+                    the luminance difference over the reference's mean (±50 %)."
+                .into(),
+            width: reference.0,
+            height: reference.1,
+            reference: reference_uri,
+            crop: hardest_region(&reference, &pictures),
+            methods,
+            charts: Vec::new(),
+        });
+    }
+    viewers
 }
 
 /// The scene's relative RMSE and FLIP against run time (runs with the most threads), one
@@ -356,6 +503,24 @@ mod tests {
         assert_eq!(file_value(rows[1].value), "16");
         assert_eq!(file_value(0.05), "0.05");
         assert!(parse_results("no,columns\n1,2\n").is_empty());
+    }
+
+    #[test]
+    fn truth_rows_are_each_models_exact_run() {
+        let text = "case,scene,medium,light,renderer,method,model,param,value,threads,seconds,shading_s,\
+                    mean_ratio_r,mean_ratio_g,mean_ratio_b,rel_rmse,rel_rmse_floor,warnings\n\
+                    c,s,skin1,quad,sss,exact,pbd,,0e0,2,3e-1,1e-1,7e-1,8e-1,9e-1,2.5e-1,,0\n\
+                    c,s,skin1,quad,sss,pathtrace,pbd,spp,2.56e2,2,5e-1,1e-1,7e-1,8e-1,9e-1,3e-1,,0\n\
+                    c,s,skin1,quad,mitsuba,volpathmis,,spp,1.6e1,2,5e-1,1e-1,1,1,1,1,,0\n";
+        let rows = parse_truth(text);
+        assert_eq!(rows.len(), 1);
+        assert_eq!(
+            (rows[0].scene.as_str(), rows[0].method.as_str()),
+            ("c", "pbd")
+        );
+        assert!((rows[0].mean_ratio - 0.8).abs() < 1e-12);
+        assert_eq!(rows[0].rel_rmse, 0.25);
+        assert!(parse_truth("case\nx\n").is_empty());
     }
 
     #[test]
