@@ -6,15 +6,6 @@ use sss_plot::{LabelledSeries, Series, hover_svg, line_plot};
 use std::fmt::Display;
 use std::path::Path;
 
-/// A number with 4 significant digits, for a point's hover label.
-fn short(v: f64) -> String {
-    if v != 0.0 && v.is_finite() && !(1e-3..1e5).contains(&v.abs()) {
-        format!("{v:.3e}")
-    } else {
-        format!("{v:.4}")
-    }
-}
-
 /// Draws `series` as the PNG `path` ([`sss_plot::line_plot`]) and, beside it with the
 /// extension `.svg`, the same chart for `report.html`, each point naming its series and
 /// coordinates on hover ([`sss_plot::hover_svg`]). For the plots of error against time.
@@ -36,8 +27,12 @@ pub fn plot_with_hover(
                 .points
                 .iter()
                 .map(|&(x, y)| {
-                    let label =
-                        format!("{}: {x_label} {}, {y_label} {}", s.name, short(x), short(y));
+                    let label = format!(
+                        "{}: {x_label} {}, {y_label} {}",
+                        s.name,
+                        md_num(Some(x), 4),
+                        md_num(Some(y), 4)
+                    );
                     (x, y, label)
                 })
                 .collect(),

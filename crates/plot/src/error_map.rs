@@ -167,6 +167,24 @@ pub fn write_error_map_with(
     draw_map(&image, &map, title, label)
 }
 
+/// Draws a FLIP map (per-pixel errors in [0, 1], as `sss_render::flip` gives them) in magma,
+/// as NVIDIA draws them, with a 0–1 colour bar labelled `FLIP` and a title, as a PNG.
+pub fn write_flip_map(
+    path: &Path,
+    width: u32,
+    height: u32,
+    values: &[f32],
+    title: &str,
+) -> Result<(), PlotError> {
+    let values: Vec<Option<f64>> = values.iter().map(|&v| Some(f64::from(v))).collect();
+    let scale = MapScale {
+        max: 1.0,
+        log: false,
+        colours: ColourMap::Magma,
+    };
+    write_error_map_with(path, width, height, &values, &scale, title, "FLIP")
+}
+
 /// Draws a map of signed per-pixel `values` (None: drawn grey) from −`max` (blue) through 0
 /// (white) to +`max` (red) with a colour bar, as a PNG: where an image is darker or brighter
 /// than its reference.

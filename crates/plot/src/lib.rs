@@ -47,7 +47,7 @@ mod error_map;
 mod hover;
 pub use error_map::{
     ColourMap, MapScale, OVER_RANGE, diverging_colour, false_colour, write_error_map,
-    write_error_map_with, write_signed_map,
+    write_error_map_with, write_flip_map, write_signed_map,
 };
 pub use hover::{LabelledSeries, escape_xml, hover_svg};
 

@@ -7,7 +7,7 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sss_bssrdf::Rgb;
-use sss_render::image::{auto_exposure, write_exr_with, write_png as write_png_file};
+use sss_render::image::{exposure_or_auto, write_exr_with, write_png as write_png_file};
 use std::path::PathBuf;
 
 /// An image argument: a float64 or float32 array (H, W, 3) (another dtype or shape gets
@@ -127,7 +127,7 @@ pub fn write_png(
     }
     py.detach(|| {
         guard(|| {
-            let e = exposure.unwrap_or_else(|| auto_exposure(&px));
+            let e = exposure_or_auto(exposure, &px);
             write_png_file(&path, w as u32, h as u32, &px, e).map_err(to_py)
         })
     })

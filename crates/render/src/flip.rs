@@ -239,6 +239,35 @@ fn clamped(i: usize, d: i64, n: usize) -> usize {
     (i as i64 + d).clamp(0, n as i64 - 1) as usize
 }
 
+/// What LDR-FLIP needs at one `ppd`, built once for every exposure of an HDR-FLIP.
+struct Filters {
+    /// The spatial filters' taps: (Y, Cx) and the two Cz terms ([`spatial_filters`]).
+    ycx: Vec<[f32; 2]>,
+    cz: Vec<[f32; 2]>,
+    /// The feature filter's taps ([`feature_filter`]).
+    feature: Vec<[f32; 3]>,
+    /// [`max_colour_distance`].
+    c_max: f32,
+}
+
+impl Filters {
+    /// The filters at `ppd` ([`DEFAULT_PPD`] for a non-finite or non-positive one).
+    fn new(ppd: f64) -> Self {
+        let ppd = if ppd.is_finite() && ppd > 0.0 {
+            ppd as f32
+        } else {
+            DEFAULT_PPD as f32
+        };
+        let (ycx, cz) = spatial_filters(ppd);
+        Filters {
+            ycx,
+            cz,
+            feature: feature_filter(ppd),
+            c_max: max_colour_distance(),
+        }
+    }
+}
+
 /// LDR-FLIP of two linear-RGB images with values in [0, 1] (others are clamped): the
 /// per-pixel error in [0, 1], row-major. Images of a size other than `width` × `height`, or
 /// empty, give an empty map.
@@ -249,23 +278,29 @@ pub fn ldr_flip(
     height: usize,
     ppd: f64,
 ) -> Vec<f32> {
+    ldr_flip_with(&Filters::new(ppd), reference, test, width, height)
+}
+
+/// [`ldr_flip`] with its filters built.
+fn ldr_flip_with(
+    filters: &Filters,
+    reference: &[[f32; 3]],
+    test: &[[f32; 3]],
+    width: usize,
+    height: usize,
+) -> Vec<f32> {
     let n = width * height;
     if n == 0 || reference.len() != n || test.len() != n {
         return Vec::new();
     }
-    let ppd = if ppd.is_finite() && ppd > 0.0 {
-        ppd as f32
-    } else {
-        DEFAULT_PPD as f32
-    };
     let to_ycxcz = |img: &[[f32; 3]]| -> Vec<[f32; 3]> {
         img.iter()
             .map(|c| xyz_to_ycxcz(rgb_to_xyz(c.map(|v| v.clamp(0.0, 1.0)))))
             .collect()
     };
     let (r, t) = (to_ycxcz(reference), to_ycxcz(test));
-    let colour = colour_difference(&r, &t, width, height, ppd);
-    let feature = feature_difference(&r, &t, width, height, ppd);
+    let colour = colour_difference(filters, &r, &t, width, height);
+    let feature = feature_difference(filters, &r, &t, width, height);
     colour
         .iter()
         .zip(&feature)
@@ -275,8 +310,14 @@ pub fn ldr_flip(
 
 /// Filters both images by the contrast sensitivity functions and returns the remapped colour
 /// difference per pixel.
-fn colour_difference(r: &[[f32; 3]], t: &[[f32; 3]], w: usize, h: usize, ppd: f32) -> Vec<f32> {
-    let (ycx, cz) = spatial_filters(ppd);
+fn colour_difference(
+    filters: &Filters,
+    r: &[[f32; 3]],
+    t: &[[f32; 3]],
+    w: usize,
+    h: usize,
+) -> Vec<f32> {
+    let (ycx, cz) = (filters.ycx.as_slice(), filters.cz.as_slice());
     let half = (ycx.len() / 2) as i64;
     // Along rows: per image (Y, Cx, Cz term 1, Cz term 2).
     let rows = |img: &[[f32; 3]]| -> Vec<[f32; 4]> {
@@ -284,7 +325,7 @@ fn colour_difference(r: &[[f32; 3]], t: &[[f32; 3]], w: usize, h: usize, ppd: f3
         out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             for (x, o) in row.iter_mut().enumerate() {
                 let mut acc = [0.0f32; 4];
-                for (k, (a, b)) in ycx.iter().zip(&cz).enumerate() {
+                for (k, (a, b)) in ycx.iter().zip(cz).enumerate() {
                     let p = img[y * w + clamped(x, k as i64 - half, w)];
                     acc[0] += a[0] * p[0];
                     acc[1] += a[1] * p[1];
@@ -297,14 +338,14 @@ fn colour_difference(r: &[[f32; 3]], t: &[[f32; 3]], w: usize, h: usize, ppd: f3
         out
     };
     let (rr, tr) = (rows(r), rows(t));
-    let c_max = max_colour_distance();
+    let c_max = filters.c_max;
     let pc_max = PC * c_max;
     let mut out = vec![0.0f32; w * h];
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, o) in row.iter_mut().enumerate() {
             let mut fr = [0.0f32; 4];
             let mut ft = [0.0f32; 4];
-            for (k, (a, b)) in ycx.iter().zip(&cz).enumerate() {
+            for (k, (a, b)) in ycx.iter().zip(cz).enumerate() {
                 let i = clamped(y, k as i64 - half, h) * w + x;
                 let weights = [a[0], a[1], b[0], b[1]];
                 for c in 0..4 {
@@ -326,8 +367,14 @@ fn colour_difference(r: &[[f32; 3]], t: &[[f32; 3]], w: usize, h: usize, ppd: f3
 }
 
 /// The feature (edge and point) difference per pixel, from the luminance of both images.
-fn feature_difference(r: &[[f32; 3]], t: &[[f32; 3]], w: usize, h: usize, ppd: f32) -> Vec<f32> {
-    let filter = feature_filter(ppd);
+fn feature_difference(
+    filters: &Filters,
+    r: &[[f32; 3]],
+    t: &[[f32; 3]],
+    w: usize,
+    h: usize,
+) -> Vec<f32> {
+    let filter = &filters.feature;
     let half = (filter.len() / 2) as i64;
     // Along rows: (first derivative, second derivative, Gaussian) of the luminance in [0, 1].
     let rows = |img: &[[f32; 3]]| -> Vec<[f32; 3]> {
@@ -456,6 +503,7 @@ pub fn hdr_flip(
         .count
         .unwrap_or_else(|| (stop - start).ceil().max(2.0) as usize)
         .clamp(2, MAX_EXPOSURES);
+    let filters = Filters::new(params.ppd);
     let step = (stop - start) / (count - 1) as f64;
     let mut map = vec![0.0f32; n];
     for i in 0..count {
@@ -463,7 +511,7 @@ pub fn hdr_flip(
         let expose = |img: &[[f32; 3]]| -> Vec<[f32; 3]> {
             img.iter().map(|p| p.map(|v| tone_map(v * scale))).collect()
         };
-        let ldr = ldr_flip(&expose(&r), &expose(&t), width, height, params.ppd);
+        let ldr = ldr_flip_with(&filters, &expose(&r), &expose(&t), width, height);
         for (m, e) in map.iter_mut().zip(ldr) {
             *m = m.max(e);
         }

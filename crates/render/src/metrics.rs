@@ -37,6 +37,20 @@ pub fn relative_errors(image: &[Rgb], reference: &[Rgb], pixels: &[usize]) -> Ve
         .collect()
 }
 
+/// Per-pixel signed relative error of the channel mean: (mean_c a − mean_c b) / max(mean_c b,
+/// floor), with the `floor` of [`relative_errors`]: negative where the image is too dark.
+pub fn signed_relative_errors(image: &[Rgb], reference: &[Rgb], pixels: &[usize]) -> Vec<f64> {
+    let floor = (reference_mean(reference, pixels) * 0.01).max(1e-300);
+    let mean = |p: &Rgb| p.iter().sum::<f64>() / 3.0;
+    pixels
+        .iter()
+        .map(|&i| {
+            let b = mean(&reference[i]);
+            (mean(&image[i]) - b) / b.max(floor)
+        })
+        .collect()
+}
+
 fn reference_mean(reference: &[Rgb], pixels: &[usize]) -> f64 {
     if pixels.is_empty() {
         return 0.0;

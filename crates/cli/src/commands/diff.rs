@@ -6,7 +6,7 @@ use crate::commands::render::check_output;
 use crate::plot_error;
 use clap::Args;
 use sss_bssrdf::Rgb;
-use sss_plot::{ColourMap, MapScale, write_error_map_with};
+use sss_plot::{ColourMap, MapScale, write_error_map_with, write_flip_map};
 use sss_render::Error;
 use sss_render::flip::{FlipParams, hdr_flip};
 use sss_render::image::{check_exr_budget, read_exr_within};
@@ -138,20 +138,12 @@ pub fn run(args: &DiffArgs) -> Result<String, Error> {
         &FlipParams::default(),
     );
     if let Some(p) = &args.flip_map {
-        let values: Vec<Option<f64>> = flip.map.iter().map(|&v| Some(f64::from(v))).collect();
-        let scale = MapScale {
-            max: 1.0,
-            log: false,
-            colours: ColourMap::Magma,
-        };
-        write_error_map_with(
+        write_flip_map(
             p,
             w,
             h,
-            &values,
-            &scale,
+            &flip.map,
             &format!("HDR-FLIP, layer {} (mean {:.4})", args.layer, flip.mean),
-            "FLIP",
         )
         .map_err(plot_error)?;
     }

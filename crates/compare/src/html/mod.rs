@@ -48,6 +48,11 @@ pub fn base64(bytes: &[u8]) -> String {
     out
 }
 
+/// PNG bytes as a data URI.
+pub fn data_uri_of_png(bytes: &[u8]) -> String {
+    format!("data:image/png;base64,{}", base64(bytes))
+}
+
 /// The file at `path` as a data URI (PNG or SVG by its extension), or `None` where it cannot
 /// be read or is of another kind.
 pub fn data_uri(path: &Path) -> Option<String> {
@@ -84,7 +89,7 @@ fn picture(path: &Path, alt: &str) -> Option<String> {
 /// show (the error-against-time plots of each experiment among them), except the scenes'
 /// `error_vs_time_<scene>.png`, whose charts the viewers draw.
 pub fn write(out: &Path, report: &str) -> Result<(), Error> {
-    let mut viewers = scenes::viewers(out)?;
+    let mut viewers = scenes::viewers(out);
     viewers.extend(scenes::truth_viewers(out));
     let mut shown: Vec<String> = viewers
         .iter()
@@ -100,15 +105,10 @@ pub fn write(out: &Path, report: &str) -> Result<(), Error> {
         picture(&out.join(rel), alt)
     };
     let mut body = markdown::to_html(report, &mut image);
-    let mut rest: Vec<String> = std::fs::read_dir(out)
-        .map(|d| {
-            d.filter_map(|e| e.ok())
-                .filter_map(|e| e.file_name().to_str().map(String::from))
-                .filter(|f| f.ends_with(".png") && !shown.contains(f))
-                .collect()
-        })
-        .unwrap_or_default();
-    rest.sort();
+    let rest: Vec<String> = scenes::file_names(out)
+        .into_iter()
+        .filter(|f| f.ends_with(".png") && !shown.contains(f))
+        .collect();
     if !rest.is_empty() {
         body.push_str("<h2 id=\"every-plot\">Every other plot of this run</h2>\n");
         for f in &rest {

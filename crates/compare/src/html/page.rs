@@ -1,6 +1,7 @@
 //! The page itself: markup of each scene's viewer, the style sheet and the script (inline:
 //! the page needs nothing beyond its own file).
 
+use super::super::output::{md_num, md_pct};
 use super::markdown::slug;
 use super::scenes::{MethodView, Viewer};
 use sss_plot::escape_xml;
@@ -92,50 +93,24 @@ const SCRIPT: &str = r#"
 })();
 "#;
 
-/// A figure with `digits` significant digits, or a dash.
-fn fig(v: Option<f64>, digits: usize) -> String {
-    match v {
-        Some(0.0) => "0".into(),
-        Some(x) if x.is_finite() => {
-            let s = format!("{x:.*e}", digits.saturating_sub(1));
-            // Plain notation within [1e-3, 1e5).
-            if (1e-3..1e5).contains(&x.abs()) {
-                let mag = x.abs().log10().floor() as i32;
-                let decimals = (digits as i32 - 1 - mag).max(0) as usize;
-                format!("{x:.decimals$}")
-            } else {
-                s
-            }
-        }
-        _ => "–".into(),
-    }
-}
-
-fn pct(v: Option<f64>) -> String {
-    match v {
-        Some(x) if x.is_finite() => format!("{} %", fig(Some(100.0 * x), 3)),
-        _ => "–".into(),
-    }
-}
-
 /// The figures of a method's run, one line.
 fn caption(m: &MethodView) -> String {
     match &m.row {
         Some(r) => format!(
             "<b>{}</b>: {} s ({} threads), rel. RMSE {}, FLIP {}, mean / ref. mean {}, within 5 %: {}",
             escape_xml(&m.label),
-            fig(Some(r.seconds), 3),
+            md_num(Some(r.seconds), 3),
             r.threads,
-            pct(Some(r.rel_rmse)),
-            fig(r.flip, 3),
-            fig(Some(r.mean_ratio), 4),
-            pct(Some(r.frac_within_eps))
+            md_pct(Some(r.rel_rmse)),
+            md_num(r.flip, 3),
+            md_num(Some(r.mean_ratio), 4),
+            md_pct(Some(r.frac_within_eps))
         ),
         None => format!("<b>{}</b>", escape_xml(&m.label)),
     }
 }
 
-fn img(uri: &Option<String>, class: &str, alt: &str, m: Option<usize>) -> String {
+fn img(uri: Option<&str>, class: &str, alt: &str, m: Option<usize>) -> String {
     match uri {
         Some(u) => format!(
             "<img class=\"{class}\"{} src=\"{}\" alt=\"{}\">",
@@ -185,10 +160,15 @@ fn viewer(v: &Viewer) -> String {
         );
     }
     s.push_str("</div><div class=\"stage\"><div class=\"stack\">");
-    s.push_str(&img(&Some(v.reference.clone()), "ref", "reference", None));
+    s.push_str(&img(Some(&v.reference), "ref", "reference", None));
     for (i, m) in v.methods.iter().enumerate() {
         if m.image.is_some() {
-            s.push_str(&img(&m.image, &format!("test{}", on(i)), &m.label, Some(i)));
+            s.push_str(&img(
+                m.image.as_deref(),
+                &format!("test{}", on(i)),
+                &m.label,
+                Some(i),
+            ));
         }
     }
     s.push_str(
@@ -233,19 +213,19 @@ fn viewer(v: &Viewer) -> String {
     for (i, m) in v.methods.iter().enumerate() {
         let _ = write!(s, "<div class=\"{}\" data-m=\"{i}\">", on(i).trim());
         s.push_str(&img(
-            &m.signed,
+            m.signed.as_deref(),
             "map",
             &format!("{}: signed error", m.label),
             None,
         ));
         s.push_str(&img(
-            &m.error,
+            m.error.as_deref(),
             "map",
             &format!("{}: relative error", m.label),
             None,
         ));
         s.push_str(&img(
-            &m.flip,
+            m.flip.as_deref(),
             "map",
             &format!("{}: HDR-FLIP", m.label),
             None,
@@ -265,12 +245,12 @@ fn viewer(v: &Viewer) -> String {
              <td>{}</td><td>{}</td><td>{}</td></tr>",
             on(i).trim(),
             escape_xml(&m.label),
-            fig(r.map(|r| r.seconds), 3),
+            md_num(r.map(|r| r.seconds), 3),
             r.map_or("–".into(), |r| r.threads.to_string()),
-            pct(r.map(|r| r.rel_rmse)),
-            fig(r.and_then(|r| r.flip), 3),
-            fig(r.map(|r| r.mean_ratio), 4),
-            pct(r.map(|r| r.frac_within_eps)),
+            md_pct(r.map(|r| r.rel_rmse)),
+            md_num(r.and_then(|r| r.flip), 3),
+            md_num(r.map(|r| r.mean_ratio), 4),
+            md_pct(r.map(|r| r.frac_within_eps)),
         );
     }
     s.push_str("</tbody></table><div class=\"charts\">");
@@ -320,14 +300,14 @@ mod tests {
 
     #[test]
     fn figures_read_plainly() {
-        assert_eq!(fig(Some(4.56789), 3), "4.57");
-        assert_eq!(fig(Some(0.012345), 3), "0.0123");
-        assert_eq!(fig(Some(1234.4), 3), "1234");
-        assert_eq!(fig(Some(2.5e-5), 2), "2.5e-5");
-        assert_eq!(fig(Some(0.0), 3), "0");
-        assert_eq!(fig(None, 3), "–");
-        assert_eq!(fig(Some(f64::NAN), 3), "–");
-        assert_eq!(pct(Some(0.0391)), "3.91 %");
+        assert_eq!(md_num(Some(4.56789), 3), "4.57");
+        assert_eq!(md_num(Some(0.012345), 3), "0.0123");
+        assert_eq!(md_num(Some(1234.4), 3), "1234");
+        assert_eq!(md_num(Some(2.5e-5), 2), "2.5e-5");
+        assert_eq!(md_num(Some(0.0), 3), "0");
+        assert_eq!(md_num(None, 3), "–");
+        assert_eq!(md_num(Some(f64::NAN), 3), "–");
+        assert_eq!(md_pct(Some(0.0391)), "3.91 %");
     }
 
     #[test]

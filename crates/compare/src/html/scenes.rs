@@ -1,8 +1,7 @@
 //! What the page shows of each scene, read from the output directory: the pictures under
 //! `scenes/<scene>/` and the runs of `results.csv`.
 
-use super::super::Error;
-use super::data_uri;
+use super::{data_uri, data_uri_of_png};
 use sss_plot::{LabelledSeries, hover_svg};
 use std::path::Path;
 
@@ -110,10 +109,12 @@ pub struct Viewer {
     pub charts: Vec<String>,
 }
 
-/// An 8-bit RGB picture decoded from a PNG (RGB or RGBA, 8 bits), or `None`.
-pub fn decode_rgb(path: &Path) -> Option<(u32, u32, Vec<[u8; 3]>)> {
-    let file = std::fs::File::open(path).ok()?;
-    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+/// The pixels of a picture: width, height, 8-bit RGB.
+pub type Pixels = (u32, u32, Vec<[u8; 3]>);
+
+/// An 8-bit RGB picture decoded from PNG bytes (RGB or RGBA, 8 bits), or `None`.
+pub fn decode_rgb(png_bytes: &[u8]) -> Option<Pixels> {
+    let mut reader = png::Decoder::new(std::io::Cursor::new(png_bytes))
         .read_info()
         .ok()?;
     let mut buf = vec![0; reader.output_buffer_size()?];
@@ -133,13 +134,45 @@ pub fn decode_rgb(path: &Path) -> Option<(u32, u32, Vec<[u8; 3]>)> {
     Some((info.width, info.height, px))
 }
 
+/// The names in directory `dir`, sorted (none where it cannot be read).
+pub fn file_names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .filter_map(|e| e.file_name().to_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    names
+}
+
+/// The PNG at `path`, read once: its data URI and its pixels.
+fn read_picture(path: &Path) -> Option<(String, Option<Pixels>)> {
+    let bytes = std::fs::read(path).ok()?;
+    Some((data_uri_of_png(&bytes), decode_rgb(&bytes)))
+}
+
+/// A method's picture at `path` as a data URI; its pixels join `same_size` when they are as
+/// large as the reference (`size`), for the hardest region.
+fn method_picture(
+    path: &Path,
+    size: (u32, u32),
+    same_size: &mut Vec<Vec<[u8; 3]>>,
+) -> Option<String> {
+    let (uri, pixels) = read_picture(path)?;
+    if let Some((w, h, px)) = pixels
+        && (w, h) == size
+    {
+        same_size.push(px);
+    }
+    Some(uri)
+}
+
 /// The window of a quarter of each side (at least 8 pixels, at most the picture) where the
 /// pictures differ most from the reference, summed over pictures and channels; `None` when
 /// no picture matches the reference's size or none differs.
-pub fn hardest_region(
-    reference: &(u32, u32, Vec<[u8; 3]>),
-    others: &[Vec<[u8; 3]>],
-) -> Option<[u32; 4]> {
+pub fn hardest_region(reference: &Pixels, others: &[Vec<[u8; 3]>]) -> Option<[u32; 4]> {
     let (w, h, r) = reference;
     let (w, h) = (*w as usize, *h as usize);
     let n = w * h;
@@ -184,9 +217,14 @@ fn file_value(v: f64) -> String {
     format!("{v}")
 }
 
+/// The stem of a run's pictures: `<method>_<value>`.
+fn stem(r: &Row) -> String {
+    format!("{}_{}", r.method, file_value(r.value))
+}
+
 /// The viewers of every scene with a `scenes/<scene>/reference.png`, in the order of
 /// `results.csv` (then by name); each method in the order of its first run.
-pub fn viewers(out: &Path) -> Result<Vec<Viewer>, Error> {
+pub fn viewers(out: &Path) -> Vec<Viewer> {
     let dir = out.join("scenes");
     let rows = std::fs::read_to_string(out.join("results.csv"))
         .map(|t| parse_results(&t))
@@ -197,71 +235,51 @@ pub fn viewers(out: &Path) -> Result<Vec<Viewer>, Error> {
             names.push(r.scene.clone());
         }
     }
-    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
-        .map(|d| {
-            d.filter_map(|e| e.ok())
-                .filter(|e| e.path().is_dir())
-                .filter_map(|e| e.file_name().to_str().map(String::from))
-                .collect()
-        })
-        .unwrap_or_default();
-    on_disk.sort();
-    for n in on_disk {
-        if !names.contains(&n) {
+    for n in file_names(&dir) {
+        if !names.contains(&n) && dir.join(&n).is_dir() {
             names.push(n);
         }
     }
     let mut viewers = Vec::new();
     for scene in names {
         let sdir = dir.join(&scene);
-        let Some(reference) = decode_rgb(&sdir.join("reference.png")) else {
-            continue;
-        };
-        let Some(reference_uri) = data_uri(&sdir.join("reference.png")) else {
+        let Some((reference_uri, Some(reference))) = read_picture(&sdir.join("reference.png"))
+        else {
             continue;
         };
         let runs: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
         // The methods with pictures: each `<method>_<value>_flip.png` or `_error.png`.
-        let mut stems: Vec<String> = std::fs::read_dir(&sdir)
-            .map(|d| {
-                d.filter_map(|e| e.ok())
-                    .filter_map(|e| e.file_name().to_str().map(String::from))
-                    .filter_map(|f| {
-                        f.strip_suffix("_error.png")
-                            .or_else(|| f.strip_suffix("_flip.png"))
-                            .map(String::from)
-                    })
-                    .collect()
+        let mut stems: Vec<String> = file_names(&sdir)
+            .iter()
+            .filter_map(|f| {
+                f.strip_suffix("_error.png")
+                    .or_else(|| f.strip_suffix("_flip.png"))
+                    .map(String::from)
             })
-            .unwrap_or_default();
+            .collect();
         stems.sort();
         stems.dedup();
-        let first_run = |stem: &str| {
+        stems.sort_by_key(|s| {
             runs.iter()
-                .position(|r| format!("{}_{}", r.method, file_value(r.value)) == stem)
+                .position(|r| stem(r) == *s)
                 .unwrap_or(usize::MAX)
-        };
-        stems.sort_by_key(|s| first_run(s));
+        });
         let mut pictures = Vec::new();
         let mut methods = Vec::new();
-        for stem in &stems {
+        for s in &stems {
             let row = runs
                 .iter()
-                .filter(|r| format!("{}_{}", r.method, file_value(r.value)) == *stem)
+                .filter(|r| stem(r) == *s)
                 .max_by_key(|r| r.threads)
                 .map(|r| (*r).clone());
-            let label = row.as_ref().map_or(stem.clone(), |r| {
+            let label = row.as_ref().map_or(s.clone(), |r| {
                 format!("{} {}={}", r.method, r.param, file_value(r.value))
             });
-            let file = |suffix: &str| data_uri(&sdir.join(format!("{stem}{suffix}.png")));
-            if let Some((w, h, px)) = decode_rgb(&sdir.join(format!("{stem}.png")))
-                && (w, h) == (reference.0, reference.1)
-            {
-                pictures.push(px);
-            }
+            let file = |suffix: &str| data_uri(&sdir.join(format!("{s}{suffix}.png")));
+            let size = (reference.0, reference.1);
             methods.push(MethodView {
                 label,
-                image: file(""),
+                image: method_picture(&sdir.join(format!("{s}.png")), size, &mut pictures),
                 signed: file("_signed"),
                 error: file("_error"),
                 flip: file("_flip"),
@@ -282,7 +300,7 @@ pub fn viewers(out: &Path) -> Result<Vec<Viewer>, Error> {
             charts: charts(&scene, &runs),
         });
     }
-    Ok(viewers)
+    viewers
 }
 
 /// The rows of `truth.csv` text as the page shows them: each model's `exact` image of a case
@@ -294,7 +312,18 @@ pub fn parse_truth(text: &str) -> Vec<Row> {
     };
     let header: Vec<&str> = header.split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name);
-    let cols = [
+    let [
+        Some(case),
+        Some(renderer),
+        Some(method),
+        Some(model),
+        Some(threads),
+        Some(seconds),
+        Some(rel),
+        Some(r),
+        Some(g),
+        Some(b),
+    ] = [
         "case",
         "renderer",
         "method",
@@ -306,25 +335,7 @@ pub fn parse_truth(text: &str) -> Vec<Row> {
         "mean_ratio_g",
         "mean_ratio_b",
     ]
-    .map(col);
-    let Some(
-        [
-            case,
-            renderer,
-            method,
-            model,
-            threads,
-            seconds,
-            rel,
-            r,
-            g,
-            b,
-        ],
-    ) = cols
-        .iter()
-        .copied()
-        .collect::<Option<Vec<usize>>>()
-        .and_then(|v| <[usize; 10]>::try_from(v).ok())
+    .map(col)
     else {
         return Vec::new();
     };
@@ -359,46 +370,25 @@ pub fn truth_viewers(out: &Path) -> Vec<Viewer> {
     let rows = std::fs::read_to_string(out.join("truth.csv"))
         .map(|t| parse_truth(&t))
         .unwrap_or_default();
-    let mut cases: Vec<String> = std::fs::read_dir(&dir)
-        .map(|d| {
-            d.filter_map(|e| e.ok())
-                .filter(|e| e.path().join("reference.png").is_file())
-                .filter_map(|e| e.file_name().to_str().map(String::from))
-                .collect()
-        })
-        .unwrap_or_default();
-    cases.sort();
     let mut viewers = Vec::new();
-    for case in cases {
+    for case in file_names(&dir) {
         let cdir = dir.join(&case);
-        let (Some(reference), Some(reference_uri)) = (
-            decode_rgb(&cdir.join("reference.png")),
-            data_uri(&cdir.join("reference.png")),
-        ) else {
+        let Some((reference_uri, Some(reference))) = read_picture(&cdir.join("reference.png"))
+        else {
             continue;
         };
-        let mut models: Vec<String> = std::fs::read_dir(&cdir)
-            .map(|d| {
-                d.filter_map(|e| e.ok())
-                    .filter_map(|e| e.file_name().to_str().map(String::from))
-                    .filter_map(|f| f.strip_suffix("_difference.png").map(String::from))
-                    .collect()
-            })
-            .unwrap_or_default();
-        models.sort();
+        let models: Vec<String> = file_names(&cdir)
+            .iter()
+            .filter_map(|f| f.strip_suffix("_difference.png").map(String::from))
+            .collect();
         let mut pictures = Vec::new();
         let methods = models
             .iter()
             .map(|m| {
-                let path = cdir.join(format!("{m}.png"));
-                if let Some((w, h, px)) = decode_rgb(&path)
-                    && (w, h) == (reference.0, reference.1)
-                {
-                    pictures.push(px);
-                }
+                let size = (reference.0, reference.1);
                 MethodView {
                     label: format!("exact, {m}"),
-                    image: data_uri(&path),
+                    image: method_picture(&cdir.join(format!("{m}.png")), size, &mut pictures),
                     signed: data_uri(&cdir.join(format!("{m}_difference.png"))),
                     error: None,
                     flip: None,

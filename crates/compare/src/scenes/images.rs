@@ -4,10 +4,10 @@
 use super::super::Error;
 use super::EPS;
 use sss_bssrdf::Rgb;
-use sss_plot::{ColourMap, MapScale, write_error_map, write_error_map_with, write_signed_map};
+use sss_plot::{write_error_map, write_flip_map, write_signed_map};
 use sss_render::RenderOutput;
 use sss_render::image::write_png;
-use sss_render::metrics::relative_errors;
+use sss_render::metrics::{relative_errors, signed_relative_errors};
 use std::path::Path;
 
 /// Writes `<name>.png` (the subsurface image), `<name>_error.png` (its relative error against
@@ -31,11 +31,15 @@ pub fn write_images(
         exposure,
     )
     .map_err(e)?;
-    let rel = relative_errors(&out.subsurface, reference, pixels);
-    let mut values = vec![None; out.subsurface.len()];
-    for (k, &i) in pixels.iter().enumerate() {
-        values[i] = Some(rel[k]);
-    }
+    // Per-pixel values of the scored pixels, the others empty (drawn grey).
+    let on_pixels = |values: Vec<f64>| {
+        let mut all = vec![None; out.subsurface.len()];
+        for (&i, v) in pixels.iter().zip(values) {
+            all[i] = Some(v);
+        }
+        all
+    };
+    let values = on_pixels(relative_errors(&out.subsurface, reference, pixels));
     write_error_map(
         &dir.join(format!("{name}_error.png")),
         out.width,
@@ -46,20 +50,7 @@ pub fn write_images(
         "|a-ref|/ref",
     )
     .map_err(|e| Error(e.to_string()))?;
-    // Signed: (mean_c a − mean_c b) / max(mean_c b, 1 % of the reference's mean), the floor of
-    // `relative_errors`, so that nearly black pixels do not dominate.
-    let mean = |p: &Rgb| (p[0] + p[1] + p[2]) / 3.0;
-    let floor = if pixels.is_empty() {
-        0.0
-    } else {
-        pixels.iter().map(|&i| mean(&reference[i])).sum::<f64>() / pixels.len() as f64 * 0.01
-    };
-    let mut signed = vec![None; out.subsurface.len()];
-    for &i in pixels {
-        let b = mean(&reference[i]);
-        let d = b.max(floor).max(1e-300);
-        signed[i] = Some((mean(&out.subsurface[i]) - b) / d);
-    }
+    let signed = on_pixels(signed_relative_errors(&out.subsurface, reference, pixels));
     write_signed_map(
         &dir.join(format!("{name}_signed.png")),
         out.width,
@@ -70,20 +61,12 @@ pub fn write_images(
         "(a-ref)/ref",
     )
     .map_err(|e| Error(e.to_string()))?;
-    let values: Vec<Option<f64>> = flip.iter().map(|&v| Some(f64::from(v))).collect();
-    let scale = MapScale {
-        max: 1.0,
-        log: false,
-        colours: ColourMap::Magma,
-    };
-    write_error_map_with(
+    write_flip_map(
         &dir.join(format!("{name}_flip.png")),
         out.width,
         out.height,
-        &values,
-        &scale,
+        flip,
         &format!("{name}: HDR-FLIP against exact"),
-        "FLIP",
     )
     .map_err(|e| Error(e.to_string()))
 }

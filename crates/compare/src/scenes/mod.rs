@@ -38,7 +38,7 @@ use images::write_images;
 use runs::{Outcome, results_csv, run_timed};
 use sss_plot::{PALETTE, Series, SeriesStyle, line_plot};
 use sss_render::RenderSettings;
-use sss_render::flip::{FlipMap, FlipParams, hdr_flip};
+use sss_render::flip::{FlipParams, hdr_flip};
 use sss_render::image::{exposure_or_auto, write_png};
 use sss_render::integrators::exact::reference_spacing;
 use sss_render::integrators::{Converges, METHODS, Method, MethodOptions};
@@ -69,12 +69,6 @@ impl Experiment for SceneComparison {
         let results: Vec<UnitResult> = results.into_iter().map(|(_, r)| r).collect();
         assemble(ctx, &plan.outline(), &info, &results)
     }
-}
-
-/// A unit's FLIP: computed on its first run, taken from it by the others.
-enum FlipOfUnit {
-    Known(f64),
-    Map(FlipMap),
 }
 
 /// A scene made ready for its units: the reference, the pixels scored, the exposure of its
@@ -208,20 +202,21 @@ pub(super) fn run_units(
             let reference = &prepared.reference.subsurface;
             let pixels = &prepared.pixels;
             let f = error_figures(&out.subsurface, reference, pixels, EPS);
-            // A unit's runs give the same image whatever their threads: FLIP once.
-            let flip = match runs.first() {
-                Some(first) => FlipOfUnit::Known(first.flip),
-                None => FlipOfUnit::Map(hdr_flip(
+            // A unit's runs give the same image whatever their threads: FLIP on the first,
+            // the others take its mean.
+            let map = runs.is_empty().then(|| {
+                hdr_flip(
                     &out.subsurface,
                     reference,
                     out.width as usize,
                     out.height as usize,
                     &FlipParams::default(),
-                )),
-            };
+                )
+            });
+            let flip = map.as_ref().map_or_else(|| runs[0].flip, |m| m.mean);
             if threads == all_threads
                 && unit.value + 1 == values.len()
-                && let FlipOfUnit::Map(map) = &flip
+                && let Some(map) = &map
             {
                 write_images(
                     &prepared.dir,
@@ -248,10 +243,7 @@ pub(super) fn run_units(
                     .as_ref()
                     .and_then(|se| frac_within_se(&out.subsurface, se, reference, pixels, 3.0)),
                 mean_ratio: mean_ratio(&out.subsurface, reference, pixels),
-                flip: match &flip {
-                    FlipOfUnit::Known(v) => *v,
-                    FlipOfUnit::Map(map) => map.mean,
-                },
+                flip,
                 warnings: out.warnings.clone(),
             });
         }
