@@ -5,8 +5,8 @@
 //   `mm_per_pixel` (the world-space size of one pixel on that pixel's surface), read linearly
 //   between the two nearest texels along the pass's axis (clamped to the edges).
 // - Sub-pixel skip: a pixel whose kernel diameter, 2 × support / mm_per_pixel, is under
-//   `min_footprint_px` pixels (or whose mm_per_pixel is not a positive number) is not blurred:
-//   its output is its input times the pass's kernel sum.
+//   `min_footprint_px` pixels or over 2^24 pixels (or whose mm_per_pixel is not a positive
+//   number) is not blurred: its output is its input times the pass's kernel sum.
 // - Silhouettes: a texel is dropped when it shows another object id or its depth differs from
 //   the centre pixel's by more than depth_threshold × support (mm). The kept weights are then
 //   renormalised per channel by the weight kept; where that is not valid (a channel whose
@@ -133,13 +133,15 @@ fn begin(pixel: vec2<i32>, axis: vec2<i32>) -> Pass {
     s.wmin = vec3<f32>(0.0);
     s.wmax = vec3<f32>(0.0);
     s.any_drop = false;
-    // Sub-pixel skip: blur only where the kernel covers at least min_footprint_px pixels.
+    // Sub-pixel skip: blur only where the kernel covers at least min_footprint_px pixels,
+    // and at most 2^24 (beyond, tap positions lose their fractions in f32).
     // (Background pixels read no taps either: they output 0.)
     let mmpp = textureLoad(mm_per_pixel, pixel, 0).r;
     s.inv_scale = 0.0;
     if (s.id != NO_OBJECT && mmpp > 0.0 && mmpp < 3.0e38) {
         let inv = 1.0 / mmpp;
-        if (2.0 * params.support_mm * inv >= params.min_footprint_px && inv < 3.0e38) {
+        let span = 2.0 * params.support_mm * inv;
+        if (span >= params.min_footprint_px && span <= 16777216.0 && inv < 3.0e38) {
             s.inv_scale = inv;
         }
     }

@@ -21,8 +21,11 @@ pub enum SeparableError {
         /// The channel.
         channel: usize,
     },
-    /// The singular value decomposition failed (faer's error, as text).
+    /// The singular value decomposition failed (non-finite input, or no convergence).
     Svd(String),
+    /// A kernel file ([`crate::kernel_json`]) that cannot be read or written: the message
+    /// names the field and what is wrong with it.
+    KernelFile(String),
 }
 
 impl fmt::Display for SeparableError {
@@ -39,6 +42,7 @@ impl fmt::Display for SeparableError {
                 "kernel has no energy in channel {channel}, cannot renormalise it"
             ),
             SeparableError::Svd(m) => write!(f, "singular value decomposition failed: {m}"),
+            SeparableError::KernelFile(m) => write!(f, "kernel file: {m}"),
         }
     }
 }

@@ -17,6 +17,7 @@
 //! | sum of N Gaussians, N = 1..6 | [`gaussians`] | 2N | d'Eon et al. 2007, Eq. 3 |
 //! | importance-sampled / uniform taps | [`taps`] | | §6 |
 //! | a kernel as GLSL / HLSL / WGSL constants | [`shader`] | | |
+//! | a kernel as a JSON file (`sss kernel --format json`), written and read back | [`kernel_json`] | | |
 //!
 //! Every kernel ends up as the same plain data, a [`SeparableKernel`]: a list of
 //! (horizontal, vertical) [`Kernel1d`] pairs of [`Tap`]s (offset in mm, RGB weights), applied
@@ -78,6 +79,9 @@
 //!   projected pixel size, depth-aware taps).
 
 #![warn(missing_docs)]
+// The crate's only `unsafe` is the screen-space pass's AVX2 form: every block states the
+// invariant it relies on, which the differential tests and Miri check (`docs/testing.md`).
+#![deny(clippy::undocumented_unsafe_blocks)]
 
 pub mod artist;
 pub mod convolve2d;
@@ -86,6 +90,7 @@ pub mod gaussians;
 pub mod guided;
 mod kernel;
 pub mod kernel2d;
+pub mod kernel_json;
 mod optimize;
 pub mod preintegrated;
 pub mod screen_space;

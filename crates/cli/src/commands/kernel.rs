@@ -9,11 +9,13 @@
 //! passes and multiplies by R, or by its own albedo, afterwards). Multi-term kernels export
 //! each term's horizontal and vertical taps as stored (their products sum to R).
 //!
-//! The shader text comes from `sss_separable::shader` (the same constants for engines that use
-//! the library directly): one array `sssKernel` for a rank-1 kernel, `sssKernelH{i}` and
-//! `sssKernelV{i}` per term otherwise; WGSL adds each array's tap count `{name}Taps`, which
-//! WGSL cannot query. `crates/separable/examples/separable_sss.wgsl` is a two-pass compute
-//! shader that applies a pasted WGSL export with the CPU filter's silhouette rules.
+//! The JSON text comes from `sss_separable::kernel_json` (`KernelFile::to_json`), whose
+//! `KernelFile::from_json` reads it back. The shader text comes from `sss_separable::shader`
+//! (the same constants for engines that use the library directly): one array `sssKernel` for a
+//! rank-1 kernel, `sssKernelH{i}` and `sssKernelV{i}` per term otherwise; WGSL adds each
+//! array's tap count `{name}Taps`, which WGSL cannot query.
+//! `crates/separable/examples/separable_sss.wgsl` is a two-pass compute shader that applies a
+//! pasted WGSL export with the CPU filter's silhouette rules.
 
 use crate::args::{MediumArgs, model_help};
 use crate::profile_table::{MediumSpec, build_medium};
@@ -22,6 +24,7 @@ use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_render::Error;
 use sss_render::kernel_choice::check_separable_options;
 use sss_render::kernel_choice::{KernelMethod, MaterialKernel, SeparableSettings, build_kernel};
+use sss_separable::kernel_json::KernelFile;
 use sss_separable::shader::{self, ShaderLanguage, ShaderTaps};
 use sss_separable::{Energy, Kernel1d, TapPlacement, artist};
 use std::fmt::Write as _;
@@ -91,25 +94,21 @@ fn num(v: f64) -> String {
     }
 }
 
-fn taps_json(k: &Kernel1d) -> String {
-    let items: Vec<String> = k
-        .taps
-        .iter()
-        .map(|t| {
-            format!(
-                "{{\"offset_mm\": {}, \"weights\": [{}, {}, {}]}}",
-                num(t.offset_mm),
-                num(t.weight[0]),
-                num(t.weight[1]),
-                num(t.weight[2])
-            )
-        })
-        .collect();
-    format!("[{}]", items.join(", "))
+/// What every format of `sss kernel` prints: the kernel's name, the model's total diffuse
+/// reflectance, and the taps as a shader applies them.
+struct Exported {
+    /// `preintegrated`, `artist:production`, `guided:k=2`, ...
+    method: String,
+    /// The medium as given.
+    spec: MediumSpec,
+    /// The model's total diffuse reflectance per channel.
+    total: Rgb,
+    /// The taps ([`ShaderTaps::new`] with the energy `--normalize` asks for).
+    taps: ShaderTaps,
 }
 
-/// Runs `sss kernel`: the kernel text for stdout.
-pub fn run(args: &KernelArgs) -> Result<String, Error> {
+/// Builds the kernel `args` ask for and its exported taps.
+fn export(args: &KernelArgs) -> Result<Exported, Error> {
     check_separable_options(args.taps, args.k, 0.0)?;
     if !args.method.is_separable() {
         return Err(Error::Input(format!(
@@ -167,40 +166,36 @@ pub fn run(args: &KernelArgs) -> Result<String, Error> {
     } else {
         Energy::TotalReflectance
     };
-    let exported = ShaderTaps::new(&kernel, total, energy);
+    Ok(Exported {
+        method,
+        spec,
+        total,
+        taps: ShaderTaps::new(&kernel, total, energy),
+    })
+}
+
+/// Runs `sss kernel`: the kernel text for stdout.
+pub fn run(args: &KernelArgs) -> Result<String, Error> {
+    let Exported {
+        method,
+        spec,
+        total,
+        taps: exported,
+    } = export(args)?;
     let mut out = String::new();
     match args.format {
         KernelFormat::Json => {
-            let _ = write!(
-                out,
-                "{{\"method\": \"{}\", \"model\": \"{}\", \"normalized\": {}, \"total_diffuse_reflectance\": [{}, {}, {}], \"passes\": {}",
+            let file = KernelFile {
                 method,
-                args.model,
-                args.normalize,
-                num(total[0]),
-                num(total[1]),
-                num(total[2]),
-                kernel.passes()
-            );
-            match &exported {
-                ShaderTaps::Rank1(t) => {
-                    let _ = write!(out, ", \"taps\": {}", taps_json(t));
-                }
-                ShaderTaps::Terms(terms) => {
-                    let terms: Vec<String> = terms
-                        .iter()
-                        .map(|t| {
-                            format!(
-                                "{{\"horizontal\": {}, \"vertical\": {}}}",
-                                taps_json(&t.horizontal),
-                                taps_json(&t.vertical)
-                            )
-                        })
-                        .collect();
-                    let _ = write!(out, ", \"terms\": [{}]", terms.join(", "));
-                }
-            }
-            out.push_str("}\n");
+                model: args.model.to_string(),
+                normalized: args.normalize,
+                total_diffuse_reflectance: total,
+                taps: exported,
+            };
+            let text = file
+                .to_json()
+                .map_err(|e| Error::NonFinite(format!("the {} kernel: {e}", args.method)))?;
+            out.push_str(&text);
         }
         KernelFormat::Csv => {
             out.push_str("term,direction,offset_mm,weight_r,weight_g,weight_b\n");
@@ -261,4 +256,114 @@ pub fn run(args: &KernelArgs) -> Result<String, Error> {
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Cli, Command};
+    use clap::Parser;
+
+    /// The JSON writer `sss kernel` had before it moved to `sss_separable::kernel_json`,
+    /// verbatim: the library's text must stay byte for byte what users' files hold.
+    fn old_json(args: &KernelArgs, e: &Exported, passes: usize) -> String {
+        fn taps_json(k: &Kernel1d) -> String {
+            let items: Vec<String> = k
+                .taps
+                .iter()
+                .map(|t| {
+                    format!(
+                        "{{\"offset_mm\": {}, \"weights\": [{}, {}, {}]}}",
+                        num(t.offset_mm),
+                        num(t.weight[0]),
+                        num(t.weight[1]),
+                        num(t.weight[2])
+                    )
+                })
+                .collect();
+            format!("[{}]", items.join(", "))
+        }
+        let mut out = String::new();
+        let total = e.total;
+        let _ = write!(
+            out,
+            "{{\"method\": \"{}\", \"model\": \"{}\", \"normalized\": {}, \"total_diffuse_reflectance\": [{}, {}, {}], \"passes\": {}",
+            e.method,
+            args.model,
+            args.normalize,
+            num(total[0]),
+            num(total[1]),
+            num(total[2]),
+            passes
+        );
+        match &e.taps {
+            ShaderTaps::Rank1(t) => {
+                let _ = write!(out, ", \"taps\": {}", taps_json(t));
+            }
+            ShaderTaps::Terms(terms) => {
+                let terms: Vec<String> = terms
+                    .iter()
+                    .map(|t| {
+                        format!(
+                            "{{\"horizontal\": {}, \"vertical\": {}}}",
+                            taps_json(&t.horizontal),
+                            taps_json(&t.vertical)
+                        )
+                    })
+                    .collect();
+                let _ = write!(out, ", \"terms\": [{}]", terms.join(", "));
+            }
+        }
+        out.push_str("}\n");
+        out
+    }
+
+    fn kernel_args(args: &[&str]) -> KernelArgs {
+        let cli = Cli::try_parse_from([&["sss", "kernel"], args].concat()).unwrap();
+        match cli.command {
+            Command::Kernel(a) => a,
+            _ => unreachable!("parsed `sss kernel`"),
+        }
+    }
+
+    /// `sss kernel --format json` prints what the old writer printed, for rank-1 and
+    /// multi-term kernels, plain and normalised, and the library reads it back to the same
+    /// taps.
+    #[test]
+    fn kernel_json_is_the_old_text_and_reads_back() {
+        for method in [
+            &["--method", "preintegrated"][..],
+            &["--method", "svd3", "--taps", "5"],
+            &["--method", "gaussians6", "--taps", "3"],
+            &["--method", "guided", "--k", "1.5"],
+            &["--method", "artist", "--artist-preset", "production"],
+            &["--method", "svd1", "--uniform", "--taps", "4"],
+        ] {
+            for normalize in [false, true] {
+                let mut a = vec!["--preset", "marble"];
+                a.extend_from_slice(method);
+                if normalize {
+                    a.push("--normalize");
+                }
+                let args = kernel_args(&a);
+                let e = export(&args).unwrap();
+                // The old writer printed the kernel's `passes()`, 2 per term; `ShaderTaps::new`
+                // gives `Rank1` exactly for one term.
+                let passes = match &e.taps {
+                    ShaderTaps::Rank1(_) => 2,
+                    ShaderTaps::Terms(t) => 2 * t.len(),
+                };
+                let text = run(&args).unwrap();
+                assert_eq!(text, old_json(&args, &e, passes), "{a:?}");
+                let back = KernelFile::from_json(&text).unwrap();
+                assert_eq!(back.taps, e.taps, "{a:?}");
+                assert_eq!(back.total_diffuse_reflectance, e.total);
+                assert_eq!(back.normalized, normalize);
+                assert_eq!(
+                    (back.method.as_str(), back.passes()),
+                    (e.method.as_str(), passes)
+                );
+            }
+        }
+    }
 }

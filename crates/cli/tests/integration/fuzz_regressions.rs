@@ -1,6 +1,7 @@
-//! Inputs found by `cargo xtask fuzz` that once made `sss` panic, kept as regression tests.
-//! Each runs the real binary and checks for one `error:` line naming the file, exit code 2,
-//! no output and no "internal error".
+//! Inputs found by `cargo xtask fuzz` or the coverage-guided fuzzer (`fuzz/`, see
+//! docs/testing.md) that once made `sss` panic, kept as regression tests. Each runs the real
+//! binary and checks its exit code and output (an input error: one `error:` line naming the
+//! file, exit code 2, no output and no "internal error").
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -93,6 +94,49 @@ fn filter_and_diff_refuse_layers_of_different_sizes() {
     assert!(!out.exists());
     let o = sss(&["diff", input_s, input_s, "--layer", "irradiance"]);
     assert_input_error(&o, input_s);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A 4x3 OpenEXR of B44-compressed half channels `A`, `B`, `G`, `R` and `surface.{B,G,R}`
+/// whose blocks make exr's B44 decoder wrap its u32 arithmetic (552 bytes, found by the `exr`
+/// target of `fuzz/` and minimised by libFuzzer), as hex.
+const B44_WRAPPING_EXR: &str = "\
+    762f3101020000006368616e6e656c730063686c697374009700000041000100000000000000010000000100\
+    0000420001000000000000000100000001000000470001000000000000000100000001000000520001000000\
+    000000000100000001000000737572666163652e420001000000000000000100000001000000737572666163\
+    652e470001000000000000000100000001000000737572666163652e52000100000000000000010000000100\
+    000000636f6d7072657373696f6e00636f6d7072657373696f6e0001000000066461746157696e646f770062\
+    6f783269001000000000000000000000000300000002000000646973706c617957696e646f7700626f783269\
+    0010000000000000005400000003000000020000006c696e654f72646572006c696e654f7264657200010000\
+    0000706978656c4173706563745261ffffffff666c6f617400040000000000803f73637265656e57696e646f\
+    7743656e746572007632660008000000000000000000000073637265656e57696e646f77576964746800666c\
+    6f617400040000000000803f7479706500737472696e67000d0000007363616e6c696e65696d61676500be01\
+    00000000000000000000620000007f8b27b8a0de18208a0861861820ab801f69e0aa38619a18a28e2861a7ff\
+    ffff1f451fda20c238619a28a228617f8b27b8a0de18208a08618618201f69e0aa38619a18a28e2861a745da\
+    20c238619a28a29628617f8b27b8a0de18208a0861861820";
+
+/// `fuzz/run.sh` (target `exr`): exr's B44 decoder computes `s[0] + d - bias` in u32 and
+/// keeps the low 16 bits, wrapping on purpose as OpenEXR's C code does. A debug build checked
+/// the subtraction, panicked in exr's decompressor thread and aborted `sss` (exit code 134);
+/// the root Cargo.toml turns exr's overflow checks off in debug builds, so every build reads
+/// the file as a release build does. (A release build of this test passes either way; the
+/// debug one, `cargo test -p sss-cli --test integration fuzz_regressions`, fails without.)
+#[test]
+fn b44_blocks_that_wrap_read_as_in_a_release_build() {
+    let dir = tmp_dir("b44");
+    let input = dir.join("b44.exr");
+    let bytes = unhex(B44_WRAPPING_EXR);
+    assert_eq!(bytes.len(), 552);
+    std::fs::write(&input, bytes).unwrap();
+    let input_s = input.to_str().unwrap();
+    let o = sss(&["diff", input_s, input_s, "--layer", "surface"]);
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert_eq!(o.status.code(), Some(0), "stderr: {err}");
+    assert!(out.lines().next() == Some("pixels 12"), "{out}");
+    assert!(out.contains("rmse 0.000000e0"), "{out}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -106,9 +106,11 @@ pub fn to_html(markdown: &str, image: &mut Images<'_>) -> String {
         if t.is_empty() {
             flush(&mut para, &mut out, image);
             i += 1;
-        } else if let Some(level) = (1..=6)
-            .find(|&n| t.len() > n && t[..n].chars().all(|c| c == '#') && t[n..].starts_with(' '))
-        {
+        } else if let Some(level) = (1..=6).find(|&n| {
+            // Bytes, not `t[..n]`: a line may start with a character of several bytes.
+            let b = t.as_bytes();
+            b.len() > n && b[..n].iter().all(|&c| c == b'#') && b[n] == b' '
+        }) {
             flush(&mut para, &mut out, image);
             let text = t[level + 1..].trim();
             let _ = writeln!(
@@ -210,6 +212,22 @@ mod tests {
         // A lone asterisk or backtick is text.
         let h = html("3 * 4 and a ` tick");
         assert_eq!(h, "<p>3 * 4 and a ` tick</p>\n");
+    }
+
+    /// A line starting with a character of several bytes is text, not a heading, and does
+    /// not panic: the heading test sliced the line at byte 1, inside the `–` (the shard
+    /// merge's fuzz target reached it through a report section of a shard).
+    #[test]
+    fn lines_starting_with_wide_characters_are_text() {
+        for line in ["–", "–x", "é# x", "#–", "##–x", "€€€€€€€€ y", "# é"]
+        {
+            let h = html(&format!("{line}\n"));
+            if line == "# é" {
+                assert_eq!(h, "<h1 id=\"é\">é</h1>\n");
+            } else {
+                assert_eq!(h, format!("<p>{line}</p>\n"), "{line}");
+            }
+        }
     }
 
     #[test]

@@ -217,13 +217,18 @@ pub(crate) fn assemble(
     }
     let _ = writeln!(
         summary,
-        "\nEvery run's figures (all threads, and one thread at the middle of each sweep) are in \
+        "\nEvery run's figures (all threads, and one thread at the {} of each sweep) are in \
          `results.csv`; error is over \
          pixels covered by translucent objects, against the cached `exact` reference. The \
          path tracer converges to the surface integral that `exact` approximates with discrete \
          irradiance samples, so its mean ratio measures the point sum's discretisation plus \
          noise; per-pixel agreement within 3 standard errors is only meaningful at high spp \
-         (with few samples, shadowed pixels often get all-zero estimates and a zero error bar)."
+         (with few samples, shadowed pixels often get all-zero estimates and a zero error bar).",
+        if cfg.quick {
+            "first (cheapest) point"
+        } else {
+            "middle"
+        }
     );
     Ok(Section {
         title: "Scenes: references and error against run time".into(),

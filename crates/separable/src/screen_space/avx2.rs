@@ -688,9 +688,10 @@ pub(super) fn summary_cell_avx2(
     let exp = _mm256_set1_epi32(0x7F80_0000);
     let sign = _mm256_set1_epi32(i32::MIN);
     let (one, zero) = (_mm256_set1_ps(1.0), _mm256_setzero_ps());
-    let (twice_support, min_fp) = (
+    let (twice_support, min_fp, max_span) = (
         _mm256_set1_ps(2.0 * rules.support_mm),
         _mm256_set1_ps(rules.min_footprint_px),
+        _mm256_set1_ps(super::MAX_SPAN_PX),
     );
     let (mut odd, mut inv_bits) = (_mm256_setzero_si256(), _mm256_setzero_si256());
     let (mut lo, mut hi) = (_mm256_set1_epi32(-1), _mm256_setzero_si256());
@@ -711,12 +712,17 @@ pub(super) fn summary_cell_avx2(
         let key = _mm256_xor_si256(bits, _mm256_or_si256(_mm256_srai_epi32::<31>(bits), sign));
         lo = _mm256_min_epu32(lo, key);
         hi = _mm256_max_epu32(hi, key);
-        // inverse_scale_lane: (mm > 0) & mm finite & 2·support·inv ≥ min & inv finite.
+        // inverse_scale_lane: (mm > 0) & mm finite & min ≤ 2·support·inv ≤ MAX_SPAN_PX &
+        // inv finite.
         let inv = _mm256_div_ps(one, f);
+        let span = _mm256_mul_ps(twice_support, inv);
         let ok = _mm256_and_ps(
             _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(f, zero), finite_lanes(f)),
             _mm256_and_ps(
-                _mm256_cmp_ps::<_CMP_GE_OQ>(_mm256_mul_ps(twice_support, inv), min_fp),
+                _mm256_and_ps(
+                    _mm256_cmp_ps::<_CMP_GE_OQ>(span, min_fp),
+                    _mm256_cmp_ps::<_CMP_LE_OQ>(span, max_span),
+                ),
                 finite_lanes(inv),
             ),
         );

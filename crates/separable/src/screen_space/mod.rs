@@ -6,8 +6,8 @@
 //! - **Footprint.** A tap's offset in pixels is its offset in mm divided by the pixel's
 //!   `mm_per_pixel` (the world-space size of one pixel on that pixel's surface), fetched
 //!   bilinearly (clamp to edge). Pixels whose kernel diameter, 2·[`SeparableKernel::support_mm`]
-//!   / mm_per_pixel, is under [`FilterOptions::min_footprint_px`] skip the blur: output =
-//!   irradiance × the kernel's total weight.
+//!   / mm_per_pixel, is under [`FilterOptions::min_footprint_px`] (or over 2²⁴ pixels: a
+//!   broken footprint) skip the blur: output = irradiance × the kernel's total weight.
 //! - **Jitter.** Each pixel rotates its filter axes by a pseudo-random angle (one of
 //!   [`ROTATION_STEPS`]), a seeded hash of its coordinates ([`rotation_angle`], so the result
 //!   is deterministic), applied to the taps
@@ -228,6 +228,16 @@ fn bilinear_cell(sx: f32, sy: f32, w: usize, wmax: i32, hmax: i32) -> ([usize; 4
     ([cy0 + cx0, cy0 + cx1, cy1 + cx0, cy1 + cx1], fx, fy)
 }
 
+/// The widest kernel, in pixels, that a pixel blurs with (2²⁴): a footprint so small that
+/// the kernel spans more skips the blur like a sub-pixel one. Tap positions then stay within
+/// ±2²⁴ pixels, where f32 holds them exactly and their integer parts fit an i32: a footprint
+/// of 10⁻³⁰ mm per pixel (a broken G-buffer) had put taps 10³¹ pixels away, whose bilinear
+/// fractions, taken from a saturated integer part, came out near 10³¹ and summed to ±∞ and
+/// NaN. Such a kernel reads nothing but the clamped edge texels of any real image, so
+/// skipping (irradiance × the kernel's total weight: locally flat light) is the better
+/// answer as well as the finite one.
+pub(crate) const MAX_SPAN_PX: f32 = 16_777_216.0;
+
 /// The per-pixel rules shared by the separable pass and the exact 2D convolution.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Rules {
@@ -254,13 +264,15 @@ impl Rules {
 
     /// [`Rules::inverse_scale`] without branches (so a loop over pixels vectorises):
     /// 1/mm_per_pixel, and whether the pixel is blurred (a positive, finite footprint whose
-    /// kernel spans at least `min_footprint_px`).
+    /// kernel spans at least `min_footprint_px` and at most [`MAX_SPAN_PX`]).
     #[inline(always)]
     pub fn inverse_scale_lane(&self, mm_per_pixel: f32) -> (f32, bool) {
         let inv = 1.0 / mm_per_pixel;
+        let span = 2.0 * self.support_mm * inv;
         let ok = (mm_per_pixel > 0.0)
             & mm_per_pixel.is_finite()
-            & (2.0 * self.support_mm * inv >= self.min_footprint_px)
+            & (span >= self.min_footprint_px)
+            & (span <= MAX_SPAN_PX)
             & inv.is_finite();
         (inv, ok)
     }

@@ -44,6 +44,9 @@ fn avx2_summary_cells_match_the_scalar_ones() {
         f32::INFINITY,
         1e-40,
         1e-30,
+        // Around the widest kernel: 2 · 14 mm / 2²⁴ ≈ 1.669e-6 mm per pixel.
+        1.6e-6,
+        1.7e-6,
     ];
     let key = |c: &Cell| {
         (
@@ -56,7 +59,9 @@ fn avx2_summary_cells_match_the_scalar_ones() {
         )
     };
     let (mut uniform, mut blurred) = (0, 0);
-    for t in 0..4000u64 {
+    // Under Miri, which checks the loads of every cell, a tenth of the cells.
+    let cells = if cfg!(miri) { 400 } else { 4000 };
+    for t in 0..cells as u64 {
         let r = |k: u64, n: usize| (sss_util::splitmix64(t * 64 + k) % n as u64) as usize;
         // Most cells clean (one id, finite depths, valid footprints), with a few odd
         // pixels sprinkled in, so both outcomes of every test are reached.
@@ -98,8 +103,9 @@ fn avx2_summary_cells_match_the_scalar_ones() {
         blurred += usize::from(scalar.blurred);
     }
     // Both outcomes of each test were compared.
-    assert!((500..3500).contains(&uniform), "{uniform} uniform cells");
-    assert!((500..3500).contains(&blurred), "{blurred} blurred cells");
+    let both = cells / 8..cells * 7 / 8;
+    assert!(both.contains(&uniform), "{uniform} uniform cells");
+    assert!(both.contains(&blurred), "{blurred} blurred cells");
 }
 
 /// The hoisted silhouette test is the per-pixel one over whole cells: on a frame with
@@ -148,7 +154,9 @@ fn clean_is_the_per_pixel_test() {
     };
     let s = CellSummary::new(&input, &rules, Default::default(), &summary_rows(Isa::Best));
     let (mut kept, mut by_cells) = (0, 0);
-    for t in 0..20_000u64 {
+    // Under Miri, a tenth of the rectangles.
+    let tries = if cfg!(miri) { 300 } else { 20_000 };
+    for t in 0..tries as u64 {
         let r = |k: u64, m: usize| (sss_util::splitmix64(t * 16 + k) % m as u64) as usize;
         let id = if r(0, 4) == 0 { 2 } else { 1 };
         let rows = 1 + r(1, 40);
@@ -176,8 +184,11 @@ fn clean_is_the_per_pixel_test() {
         }
     }
     // Both outcomes, and rectangles that only the cells' test keeps.
-    assert!((2_000..18_000).contains(&kept), "{kept} rectangles kept");
-    assert!(by_cells >= 200, "{by_cells} kept by the cells only");
+    assert!(
+        (tries / 10..tries * 9 / 10).contains(&kept),
+        "{kept} rectangles kept"
+    );
+    assert!(by_cells >= tries / 100, "{by_cells} kept by the cells only");
 }
 
 /// The AVX2 rotation table is the scalar hash, pixel for pixel: row lengths around the
@@ -192,7 +203,7 @@ fn avx2_rotation_rows_match_the_scalar_hash() {
     let mut checked = 0;
     for seed in [0, 1, 0x9e37_79b9_7f4a_7c15, u64::MAX - 2] {
         for y in [0, 1, 7, 1079, 65_537, (1 << 31) - 1] {
-            for w in [0, 1, 3, 4, 5, 8, 13, 1921] {
+            for w in [0, 1, 3, 4, 5, 8, 13, if cfg!(miri) { 21 } else { 1921 }] {
                 let (mut a, mut b) = (vec![0u8; w], vec![0u8; w]);
                 rotation_row(y, seed, &mut a);
                 // SAFETY: the CPU was checked to support AVX2.
@@ -210,5 +221,125 @@ fn avx2_rotation_rows_match_the_scalar_hash() {
         distinct > 200,
         "{distinct} distinct rotations in 1024 pixels"
     );
-    assert_eq!(checked, 24 * 1955);
+    assert_eq!(checked, 24 * if cfg!(miri) { 55 } else { 1955 });
+}
+
+/// A kernel built from taps alone (no model or fit: cheap enough for Miri): 7 taps over
+/// ±3 mm, one positive term plus, with `signed`, a second whose vertical taps change sign.
+fn small_kernel(signed: bool) -> SeparableKernel {
+    use crate::kernel::{Kernel1d, SeparableTerm, Tap};
+    let taps = |scale: f64, alt: bool| Kernel1d {
+        taps: (0..7)
+            .map(|i| {
+                let x = i as f64 - 3.0;
+                let w = scale * (-(x * x) / 4.0).exp();
+                let s = if alt && i % 2 == 1 { -0.5 } else { 1.0 };
+                Tap {
+                    offset_mm: x,
+                    weight: [w * s, 0.8 * w * s, 0.6 * w],
+                }
+            })
+            .collect(),
+    };
+    let mut terms = vec![SeparableTerm {
+        horizontal: taps(0.3, false),
+        vertical: taps(0.3, false),
+    }];
+    if signed {
+        terms.push(SeparableTerm {
+            horizontal: taps(0.05, false),
+            vertical: taps(0.05, true),
+        });
+    }
+    SeparableKernel {
+        terms,
+        support_mm: 3.0,
+    }
+}
+
+/// The row-chunked form (with AVX2 and FMA where the CPU has them: under Miri, where the build
+/// enables them, see `docs/testing.md`), its baseline build and the per-pixel form agree on
+/// small frames that reach the fast path, the group loops' rotated-tap loads, the border
+/// path and the per-pixel fallback (another object, a depth step, a broken footprint). Sized
+/// for Miri, which checks every `unsafe` access of the AVX2 loops it executes for bounds,
+/// alignment and initialisation.
+#[test]
+fn the_forms_agree_on_small_frames() {
+    // Under Miri (about a million times slower): three rows, jitter on (the gathers and the
+    // rotated taps' loads), both kernels.
+    let (w, h) = if cfg!(miri) { (70, 3) } else { (70, 5) };
+    #[cfg(target_arch = "x86_64")]
+    eprintln!(
+        "AVX2 and FMA {}",
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        {
+            "detected: the chunks run the AVX2 loops"
+        } else {
+            "not detected: the chunks run the portable loops"
+        }
+    );
+    let n = w * h;
+    let irradiance: Vec<[f32; 3]> = (0..n)
+        .map(|i| {
+            let u = (sss_util::splitmix64(i as u64) >> 40) as f32 / (1u64 << 24) as f32;
+            [u, 0.5 * u + 0.1, 1.0 - u]
+        })
+        .collect();
+    let mut mask = vec![1u32; n];
+    let mut depth: Vec<f32> = (0..n).map(|i| 800.0 + 0.05 * (i % w) as f32).collect();
+    let mut mm: Vec<f32> = (0..n).map(|i| 0.2 + 0.001 * (i % w) as f32).collect();
+    mask[2 * w + 50] = 2;
+    depth[(h - 1) * w + 60] += 40.0;
+    mm[w + 10] = f32::NAN;
+    mm[(h - 1) * w + 30] = 1e-30;
+    let input = ScreenInput {
+        width: w,
+        height: h,
+        irradiance: &irradiance,
+        depth: &depth,
+        mask: &mask,
+        mm_per_pixel: &mm,
+    };
+    let mut fast_seen = 0.0f64;
+    for signed in [false, true] {
+        let kernel = small_kernel(signed);
+        let jitters: &[f32] = if cfg!(miri) { &[0.5] } else { &[0.0, 0.5] };
+        for &jitter in jitters {
+            let opts = FilterOptions {
+                jitter_radius: jitter,
+                seed: 3,
+                ..Default::default()
+            };
+            let run = |e| {
+                let mut out = vec![[0.0f32; 3]; n];
+                let fast =
+                    filter_into_with(&input, &kernel, &opts, &mut Default::default(), &mut out, e)
+                        .unwrap();
+                (out, fast)
+            };
+            let (reference, _) = run(Evaluation::PerPixel);
+            let scale: [f32; 3] =
+                std::array::from_fn(|c| reference.iter().map(|p| p[c].abs()).fold(0.0, f32::max));
+            let forms: &[Evaluation] = if cfg!(miri) {
+                &[Evaluation::Rows]
+            } else {
+                &[Evaluation::Rows, Evaluation::RowsBaseline]
+            };
+            for &e in forms {
+                let (out, fast) = run(e);
+                fast_seen = fast_seen.max(fast);
+                for (i, (a, b)) in out.iter().zip(&reference).enumerate() {
+                    for c in 0..3 {
+                        assert!(
+                            a[c].is_finite()
+                                && (a[c] - b[c]).abs() <= 1e-5 * b[c].abs() + 1e-6 * scale[c],
+                            "signed {signed}, jitter {jitter}, {e:?}: pixel {i} channel {c}: \
+                             {a:?} vs {b:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(fast_seen > 0.3, "fast path fraction {fast_seen}");
 }

@@ -11,6 +11,7 @@ mod mm_response;
 mod preintegrated;
 mod properties;
 mod screen_space;
+mod screen_space_random;
 mod screen_space_rows;
 mod shader_export;
 mod svd;

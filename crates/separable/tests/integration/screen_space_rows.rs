@@ -31,7 +31,7 @@ fn kernels() -> Vec<(&'static str, SeparableKernel)> {
 }
 
 /// The filtered image and the fraction of pixel passes on the fast path.
-fn run_with(
+pub(crate) fn run_with(
     f: &Frame,
     kernel: &SeparableKernel,
     opts: &FilterOptions,
