@@ -19,15 +19,10 @@
 //! Under Miri (`docs/testing.md`) the same test runs on a few small frames.
 
 use crate::common::{self, BACKGROUND, Frame};
-use crate::screen_space_rows::run_with;
+use crate::screen_space_rows::{first_off, run_with};
 use sss_separable::screen_space::{Evaluation, FilterOptions};
 use sss_separable::{SeparableKernel, TapPlacement, preintegrated};
 use sss_util::splitmix64;
-
-/// Relative tolerance per pixel and channel (as in `screen_space_rows`).
-const REL: f64 = 1e-5;
-/// Absolute floor, as a fraction of the channel's largest |value| in the reference image.
-const ABS: f64 = 1e-6;
 
 /// A seeded stream of random numbers for one frame.
 struct Draw {
@@ -148,36 +143,6 @@ fn kernels() -> Vec<(&'static str, SeparableKernel)> {
         preintegrated::kernel(&k, TapPlacement::Uniform(15)).unwrap(),
     ));
     all
-}
-
-/// The first pixel and channel where `got` is off the per-pixel `reference` by more than the
-/// tolerance, if any.
-fn first_off(f: &Frame, got: &[[f32; 3]], reference: &[[f32; 3]]) -> Option<String> {
-    let scale: [f64; 3] = std::array::from_fn(|c| {
-        reference
-            .iter()
-            .map(|p| p[c].abs() as f64)
-            .filter(|v| v.is_finite())
-            .fold(0.0, f64::max)
-    });
-    for (i, (a, b)) in got.iter().zip(reference).enumerate() {
-        for c in 0..3 {
-            let (x, r) = (a[c] as f64, b[c] as f64);
-            let ok = if r.is_finite() {
-                (x - r).abs() <= REL * r.abs() + ABS * scale[c]
-            } else {
-                a[c].to_bits() == b[c].to_bits()
-            };
-            if !ok {
-                return Some(format!(
-                    "pixel ({}, {}) channel {c}: {a:?} vs per-pixel {b:?}",
-                    i % f.width,
-                    i / f.width
-                ));
-            }
-        }
-    }
-    None
 }
 
 /// Frames per run, and their largest size: fewer and smaller under Miri.

@@ -72,33 +72,56 @@ const ABS: f64 = 1e-6;
 /// value (≈ 16 roundings of that size). A weight off by 10⁻⁴ shifts a pixel by ≈ 10⁻⁴ of
 /// that tap's share of it, far beyond both.
 fn assert_close(f: &Frame, got: &[[f32; 3]], reference: &[[f32; 3]], what: &str) {
-    let scale: [f64; 3] = std::array::from_fn(|c| {
+    if let Some(off) = first_off(f, got, reference) {
+        panic!("{what}: {off}");
+    }
+    let scale = channel_scale(reference);
+    let mut worst = 0.0f64;
+    for (a, b) in got.iter().zip(reference) {
+        for c in 0..3 {
+            let (x, r) = (a[c] as f64, b[c] as f64);
+            if r.is_finite() {
+                let err = (x - r).abs();
+                worst = worst.max(err / (r.abs() + ABS / REL * scale[c]).max(f64::MIN_POSITIVE));
+            }
+        }
+    }
+    eprintln!("{what}: largest error {worst:.2e} of the tolerance's scale");
+}
+
+/// Each channel's largest finite |value| in `reference` (the scale of [`ABS`]).
+fn channel_scale(reference: &[[f32; 3]]) -> [f64; 3] {
+    std::array::from_fn(|c| {
         reference
             .iter()
             .map(|p| p[c].abs() as f64)
             .filter(|v| v.is_finite())
             .fold(0.0, f64::max)
-    });
-    let mut worst = 0.0f64;
+    })
+}
+
+/// The first pixel and channel where `got` is off the per-pixel `reference` by more than the
+/// tolerance, if any.
+pub(crate) fn first_off(f: &Frame, got: &[[f32; 3]], reference: &[[f32; 3]]) -> Option<String> {
+    let scale = channel_scale(reference);
     for (i, (a, b)) in got.iter().zip(reference).enumerate() {
         for c in 0..3 {
             let (x, r) = (a[c] as f64, b[c] as f64);
             let ok = if r.is_finite() {
-                let err = (x - r).abs();
-                worst = worst.max(err / (r.abs() + ABS / REL * scale[c]).max(f64::MIN_POSITIVE));
-                err <= REL * r.abs() + ABS * scale[c]
+                (x - r).abs() <= REL * r.abs() + ABS * scale[c]
             } else {
                 a[c].to_bits() == b[c].to_bits()
             };
-            assert!(
-                ok,
-                "{what}: pixel ({}, {}) channel {c}: chunked {a:?} vs per-pixel {b:?}",
-                i % f.width,
-                i / f.width
-            );
+            if !ok {
+                return Some(format!(
+                    "pixel ({}, {}) channel {c}: {a:?} vs per-pixel {b:?}",
+                    i % f.width,
+                    i / f.width
+                ));
+            }
         }
     }
-    eprintln!("{what}: largest error {worst:.2e} of the tolerance's scale");
+    None
 }
 
 /// Asserts the chunked form (both builds) within tolerance of the per-pixel form; returns the
