@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
-# CI step of the Python bindings (crates/python, module `sss`): formatting and clippy of the
-# crate (its own workspace, so the root's `cargo fmt --all` and `cargo clippy --workspace`
-# do not see it), the abi3 wheel built by maturin, installed into a fresh virtual environment,
-# and the pytest suite, which compares against the `sss` binary: $SSS_BIN, else
-# target/release/sss (built by `cargo test --workspace --release`), else built here.
+# CI step of the Python bindings (crates/python, module `sss`): the abi3 wheel built by maturin,
+# installed into a fresh virtual environment, and the pytest suite, which compares against the
+# `sss` binary: $SSS_BIN, else target/release/sss (built by `cargo test --workspace --release`),
+# else built here. The crate is a member of the root workspace, so the root's `cargo fmt --all`
+# and `cargo clippy --workspace` check it.
 #
 # Run from anywhere: bash crates/python/ci.sh. Cargo builds go to $CARGO_TARGET_DIR, default
-# the repository's target/: the crate has its own Cargo.lock and feature set, but most of the
-# workspace's artifacts are reused (after `cargo test --workspace --release`, the wheel's build
-# compiles 62 crates in about 2 minutes instead of all of them).
+# the repository's target/: after `cargo test --workspace --release` the wheel's build compiles
+# only PyO3, numpy and the bindings themselves (same workspace, same features, same profile;
+# PYO3_BUILD_EXTENSION_MODULE is set by .cargo/config.toml as maturin sets it).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
@@ -18,11 +18,6 @@ manifest=crates/python/Cargo.toml
 python="${PYTHON:-python3}"
 venv=target/pybind-venv
 wheels=target/pybind-wheels
-
-echo "== python bindings: cargo fmt, clippy"
-cargo fmt --manifest-path "$manifest" -- --check
-# Release, as the root's clippy: it reuses that check of the shared dependencies.
-cargo clippy --release --manifest-path "$manifest" --all-targets -- -D warnings
 
 sss="${SSS_BIN:-target/release/sss}"
 if [ ! -x "$sss" ]; then

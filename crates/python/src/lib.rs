@@ -41,15 +41,13 @@
 //! raises (see [`progress`] for how the work is stopped); `filter`, `kernel` and `read_exr`
 //! release the GIL too.
 //!
-//! ## Outside the workspace
-//! This crate is its own workspace (`[workspace]` in its manifest, `exclude`d from the root
-//! one, with its own `Cargo.lock`): PyO3 and numpy would otherwise join the feature
-//! resolution of every `cargo … --workspace` run and change the build the other crates share,
-//! and the workspace's `cargo test`/`clippy` would need a Python interpreter. `ci.sh` beside
-//! this manifest checks it: fmt, clippy, the wheel, pytest in a fresh virtual environment.
-
-// `!(x > 0.0)` is the NaN-rejecting comparison used throughout.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+//! ## In the workspace, tested from Python
+//! A member of the root workspace (not a default member), so `cargo fmt --all` and `cargo
+//! clippy --workspace` check it and the wheel's build reuses the workspace's artifacts. It is
+//! an extension module (`PYO3_BUILD_EXTENSION_MODULE`, set in `.cargo/config.toml` as maturin
+//! sets it): Python's symbols come from the interpreter that imports it, so no Rust test
+//! binary can link it (`test = false`). `ci.sh` beside this manifest builds the wheel with
+//! maturin and runs the pytest suite in a fresh virtual environment.
 
 pub mod arrays;
 pub mod errors;

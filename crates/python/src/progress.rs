@@ -5,7 +5,7 @@
 //! Stopping: the renderer and the Monte Carlo walk have no cancel flag of their own, but both
 //! report progress from their inner loops ([`sss_render::progress::Progress`], the photon
 //! counter of `sss_cli::profile_table::compute`). When a callback raises or Ctrl-C arrives,
-//! [`Monitor::cancel`] is set and the next progress report on any worker thread unwinds with
+//! the monitor's `cancel` flag is set and the next progress report on any worker thread unwinds with
 //! [`Cancelled`] (through `resume_unwind`, which prints nothing); rayon carries the unwind to
 //! the helper thread, which catches it. Everything the call allocated is dropped on the way;
 //! nothing global is left half-built (progress is never reported inside a cache's

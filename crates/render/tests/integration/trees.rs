@@ -103,7 +103,7 @@ fn shading_every_pixel_is_no_worse_than_pixel_clusters() {
     // A frame large enough that s_p < 1, so ρ = 0.75 clusters pixels (P = ρ / max s_p > 1).
     let s = scene("sphere", 256, 192);
     let frame = Frame::prepare(&s, 1);
-    let irr = irradiance(3.0);
+    let irr = irradiance(5.0);
     let exact = run(&frame, &Exact { irradiance: irr });
     let at = |rho| {
         run(
@@ -121,7 +121,8 @@ fn shading_every_pixel_is_no_worse_than_pixel_clusters() {
     let (_, e_clustered) = errors(&clustered.values, &exact.values);
     let (_, e_every) = errors(&every.values, &exact.values);
     let (_, e_coarse) = errors(&coarse.values, &exact.values);
-    // Measured: ρ = 0: 0.0012 %, 0.75: 0.67 %, 8: 2.6 %.
+    // Measured (samples 5 mean free paths apart; at 3, 42 s instead of 24 s and the same
+    // ordering): ρ = 0: 0.00015 %, 0.75: 0.72 %, 8: 2.9 %.
     println!("rho 0: {e_every:.4e}, 0.75: {e_clustered:.4e}, 8: {e_coarse:.4e}");
     assert!(e_every < 1e-4 && e_clustered < 0.015 && e_coarse < 0.05);
     assert!(e_every <= e_clustered * (1.0 + 1e-9));
@@ -135,6 +136,7 @@ fn shading_every_pixel_is_no_worse_than_pixel_clusters() {
             .map(|x| x.value)
             .sum::<f64>()
     };
+    println!("evaluations: {:.4}", evals(&clustered) / evals(&every));
     assert!(
         evals(&clustered) < 0.95 * evals(&every),
         "{} vs {}",
