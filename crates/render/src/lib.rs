@@ -91,6 +91,7 @@ pub mod pipeline;
 pub mod probe;
 pub mod progress;
 pub mod rng;
+pub mod sampling_rate;
 pub mod shading;
 pub mod volume;
 pub mod vpls;

@@ -20,7 +20,9 @@
 //! Methods come in families, each with the code its members share in its own `mod.rs`:
 //! - [`point_sums`]: sums over irradiance samples — [`exact`], [`single_tree`], [`dual_tree`],
 //!   [`dual_tree_fmm`] (the illumination tree, the dual trees' shading points and s_p);
-//! - [`vpl`]: many-light methods over virtual point lights — [`manylight`], and under
+//! - [`vpl`]: many-light methods over virtual point lights — [`manylight`],
+//!   [`sparse_manylight`] (its estimates where the screen-space bandwidth asks, the rest
+//!   reconstructed with an interval), and under
 //!   [`vpl::gather_points`] (the fixed gather-point pipeline) [`mdlc`] and [`eelc`];
 //! - [`pathtrace`] (its probe sampler is [`crate::probe`], which the gather-point pipeline
 //!   also draws with) and [`separable`] stand alone;
@@ -48,7 +50,7 @@ pub mod vpl;
 pub use options::{MethodOptions, OptionKind, OptionSpec};
 pub use point_sums::{dual_tree, dual_tree_fmm, exact, single_tree};
 pub use vpl::gather_points::{eelc, mdlc};
-pub use vpl::manylight;
+pub use vpl::{manylight, sparse_manylight};
 
 use crate::Error;
 use crate::frame::Frame;
@@ -168,6 +170,7 @@ pub const METHODS: &[Method] = &[
     dual_tree::METHOD,
     dual_tree_fmm::METHOD,
     manylight::METHOD,
+    sparse_manylight::METHOD,
     mdlc::METHOD,
     eelc::METHOD,
     volpath::METHOD,

@@ -169,6 +169,40 @@ pub const SOLID_ANGLE_EPS: OptionSpec = OptionSpec {
     values: &[],
 };
 
+/// The values of `--selection`, as the help and the error list them: `bssrdf` (also spelt
+/// `bssrdf-aware`) and `max-extent`.
+pub const SELECTIONS: [&str; 2] = ["bssrdf", "max-extent"];
+
+/// `--selection` of the many-light estimator (`manylight`, `sparse-manylight`).
+pub const SELECTION: OptionSpec = OptionSpec {
+    name: "selection",
+    value_name: "SELECTION",
+    default: "bssrdf",
+    help: "Cluster to refine: BSSRDF-aware (Nabata & Iwasaki Eq. 10-13) or the largest box (Max-Extent)",
+    kind: OptionKind::Value,
+    values: &SELECTIONS,
+};
+
+/// `--max-triplets N` of the many-light estimator (`manylight`, `sparse-manylight`).
+pub const MAX_TRIPLETS: OptionSpec = OptionSpec {
+    name: "max-triplets",
+    value_name: "N",
+    default: "200000",
+    help: "Cap on the triplets of one pixel and object (pixels at the cap are counted and warned about)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// `--dark-floor F` of the many-light estimator (`manylight`, `sparse-manylight`).
+pub const DARK_FLOOR: OptionSpec = OptionSpec {
+    name: "dark-floor",
+    value_name: "F",
+    default: "1e-6",
+    help: "Pixels darker than F times the frame's bright level (the 90th percentile of a 32-pixel pilot at eps 0.2) stop at an absolute error of eps * F * that level instead of eps times their own value; 0: the paper's purely relative criterion",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
 /// `--eps E` of the Student-t estimators (`manylight`, `eelc`): the relative error target
 /// of Nabata & Iwasaki.
 pub const RELATIVE_EPS: OptionSpec = OptionSpec {

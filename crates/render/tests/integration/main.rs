@@ -20,6 +20,7 @@ mod ray_casting;
 mod render;
 mod scene_framing;
 mod separable_fast_path;
+mod sparse_manylight;
 mod subset_reference;
 mod trees;
 mod volpath;

@@ -1,9 +1,8 @@
 //! The `manylight` integrator against an independent brute force over the same light, its
 //! caps and refusals, and the VPLs it is built on (closed forms of their total power).
 
+use crate::common::brute_force_sphere;
 use glam::DVec3;
-use sss_bssrdf::fresnel::ft_dielectric;
-use sss_bssrdf::{fresnel_normalization, make_model};
 use sss_manylight::StudentT;
 use sss_render::frame::Frame;
 use sss_render::integrators::{self, MethodOptions};
@@ -25,88 +24,6 @@ fn scene(name: &str, w: u32, h: u32) -> Scene {
     s.camera.width = w;
     s.camera.height = h;
     s
-}
-
-/// Brute force of the sphere scene's subsurface image, written independently of the
-/// integrator: per G-buffer sample x_o, F_t(η, n·ω_o)/(cπ) Σ over the mesh triangles of
-/// R_d(‖x − x_o‖) I cos θ_i/d² F_t(η, cos θ_i) dA by the centroid rule on each triangle cut
-/// into 4^L parts (L = 4 within 0.15 units of x_o, 3 within 0.5, 1 beyond), with no shadow
-/// rays: the sphere is convex and alone, so a face is lit iff it faces the light. cos θ_i is
-/// taken against the shading normal, which on this icosphere (vertex normals radial) is the
-/// point's own direction from the centre; the face must face the light too.
-fn brute_force_sphere(scene: &Scene, frame: &Frame<'_>) -> Vec<[f64; 3]> {
-    let t = scene.translucent(0).unwrap();
-    let model = make_model(t.model, &t.medium);
-    let u = t.units_per_mm;
-    let eta = t.medium.eta();
-    let norm = 1.0 / (fresnel_normalization(eta) * PI);
-    let Light::Point {
-        position: light,
-        intensity,
-    } = scene.lights[0]
-    else {
-        panic!("sphere has one point light")
-    };
-    let mesh = &scene.objects[0].mesh;
-    let tris: Vec<[DVec3; 3]> = mesh
-        .triangles
-        .iter()
-        .map(|t| t.map(|i| mesh.positions[i as usize]))
-        .collect();
-    // E(x) F_t at the centroid of each part, for parts at every level, computed once.
-    let gb = &frame.gbuffer;
-    let spp = gb.samples_per_pixel as f64;
-    let mut out = vec![[0.0; 3]; gb.pixels()];
-    for g in &gb.samples {
-        let exit = ft_dielectric(g.n.dot(g.wo), eta) * norm / spp;
-        let mut sum = [0.0; 3];
-        for tri in &tris {
-            let c = (tri[0] + tri[1] + tri[2]) / 3.0;
-            let dist = c.distance(g.p);
-            let level = if dist < 0.15 {
-                4
-            } else if dist < 0.5 {
-                3
-            } else {
-                1
-            };
-            let nrm = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
-            let area = 0.5 * nrm.length();
-            let n = nrm / (2.0 * area);
-            let mut stack = vec![(*tri, 0)];
-            while let Some((t, l)) = stack.pop() {
-                if l < level {
-                    let m = [
-                        0.5 * (t[0] + t[1]),
-                        0.5 * (t[1] + t[2]),
-                        0.5 * (t[2] + t[0]),
-                    ];
-                    stack.push(([t[0], m[0], m[2]], l + 1));
-                    stack.push(([m[0], t[1], m[1]], l + 1));
-                    stack.push(([m[2], m[1], t[2]], l + 1));
-                    stack.push(([m[0], m[1], m[2]], l + 1));
-                    continue;
-                }
-                let x = (t[0] + t[1] + t[2]) / 3.0;
-                let a = area / 4f64.powi(level);
-                let to = light - x;
-                let d2 = to.length_squared();
-                let cos = x.normalize().dot(to) / d2.sqrt();
-                if cos <= 0.0 || n.dot(to) <= 0.0 {
-                    continue;
-                }
-                let e = cos / d2 * ft_dielectric(cos, eta) * a;
-                let rd = model.rd_rgb(x.distance(g.p) / u);
-                for c in 0..3 {
-                    sum[c] += rd[c] / (u * u) * intensity[c] * e;
-                }
-            }
-        }
-        for c in 0..3 {
-            out[g.pixel as usize][c] += exit * sum[c];
-        }
-    }
-    out
 }
 
 #[test]

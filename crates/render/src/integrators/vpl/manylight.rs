@@ -49,52 +49,33 @@
 //! **Not supported** (clear errors): the directional dipole (not radial) and pre-scatter
 //! textures (the estimator's irradiance has no texture factor).
 
-pub use super::{MIN_TRIPLETS, PROFILE_TOLERANCE, PixelResult};
-
-use super::{
-    estimate_seed, light_tree_seeded, model_error, object_data, pixel_list, pixel_result,
-    scene_box, shadow_test,
+pub use super::{
+    BRIGHT_QUANTILE, DEFAULT_DARK_FLOOR, MIN_TRIPLETS, ManyLight, PILOT_EPS, PILOT_MAX_TRIPLETS,
+    PILOT_PIXELS, PROFILE_TOLERANCE, PixelEstimate, PixelEstimator, PixelResult, SELECTIONS,
+    bright_level, parse_selection,
 };
+
+use super::{eps_sweep, estimator_options, pixel_list, pixel_result};
 use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
-use crate::integrators::options::{ALPHA, RELATIVE_EPS, VPLS, alpha_option, eps_option};
+use crate::integrators::options::{ALPHA, DARK_FLOOR, MAX_TRIPLETS, RELATIVE_EPS, SELECTION, VPLS};
 use crate::integrators::{
     Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
-    check_radial,
 };
 use crate::progress::Progress;
 use crate::vpls::vpl_count;
-use rayon::prelude::*;
-use sss_bssrdf::Rgb;
 use sss_manylight::irradiance_cluster::IcNode;
-use sss_manylight::{
-    Estimator, LightNode, Refinements, Selection, Settings, ShadingPoint, ShadingTree, StudentT,
-    Summary, Triangle, Vpl,
-};
+use sss_manylight::{LightNode, Selection, Settings, Summary, Triangle, Vpl};
 use sss_scene::Scene;
 
 /// The options of `manylight`.
 pub const OPTIONS: [OptionSpec; 9] = [
     RELATIVE_EPS,
     ALPHA,
-    OptionSpec {
-        name: "selection",
-        value_name: "SELECTION",
-        default: "bssrdf",
-        help: "Cluster to refine: BSSRDF-aware (Nabata & Iwasaki Eq. 10-13) or the largest box (Max-Extent)",
-        kind: OptionKind::Value,
-        values: &SELECTIONS,
-    },
+    SELECTION,
     VPLS,
-    OptionSpec {
-        name: "max-triplets",
-        value_name: "N",
-        default: "200000",
-        help: "Cap on the triplets of one pixel and object (pixels at the cap are counted and warned about)",
-        kind: OptionKind::Value,
-        values: &[],
-    },
+    MAX_TRIPLETS,
     OptionSpec {
         name: "bounce-vpls",
         value_name: "N",
@@ -119,14 +100,7 @@ pub const OPTIONS: [OptionSpec; 9] = [
         kind: OptionKind::Flag,
         values: &[],
     },
-    OptionSpec {
-        name: "dark-floor",
-        value_name: "F",
-        default: "1e-6",
-        help: "Pixels darker than F times the frame's bright level (the 90th percentile of a 32-pixel pilot at eps 0.2) stop at an absolute error of eps * F * that level instead of eps times their own value; 0: the paper's purely relative criterion",
-        kind: OptionKind::Value,
-        values: &[],
-    },
+    DARK_FLOOR,
 ];
 
 /// The registry entry.
@@ -138,170 +112,27 @@ pub const METHOD: Method = Method {
     sweep: Sweep {
         option: "eps",
         label: "eps",
-        // Loosest (cheapest) first.
-        values: |quick| {
-            // Not the paper's 0.02 in the default run: on the slab (a wall's shadow 2
-            // diffusion lengths deep) ε = 0.02 takes 4 minutes of the 20; finer ε goes with
-            // `cargo xtask compare --manylight` and `sss render --eps`.
-            if quick {
-                vec![0.1, 0.05]
-            } else {
-                vec![0.2, 0.1, 0.05]
-            }
-        },
+        values: eps_sweep,
     },
     converges_to: Converges::Model,
 };
 
-/// The `manylight` integrator and its settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ManyLight {
-    /// Relative error threshold ε (≥ 0; 0 refines until a cap).
-    pub eps: f64,
-    /// Confidence level α in (0, 1).
-    pub alpha: f64,
-    /// Cluster selection.
-    pub selection: Selection,
-    /// VPLs per sun, quad or environment light.
-    pub vpls: u32,
-    /// Cap on the triplets per pixel and object.
-    pub max_triplets: usize,
-    /// Cap on the triangle splits per pixel and object.
-    pub max_splits: usize,
-    /// Light paths for one-bounce VPLs ([`crate::vpls::bounce_vpls`]; 0: direct light only).
-    pub bounce_paths: u32,
-    /// Seed of the VPL sampling (`None`: the render's seed). Fixing it keeps one VPL set, and
-    /// so one integral, across renders of different seeds, as the paper's comparisons do.
-    pub vpl_seed: Option<u64>,
-    /// Mixed into every pixel estimate's seed (0 by default): another stream gives an
-    /// independent estimate over the same G-buffer and VPLs (the frame's seed also places the
-    /// camera samples, so changing it changes the pixel values being estimated).
-    pub stream: u64,
-    /// Re-sample the final triplets before reporting (unbiased; `false`: the paper's
-    /// estimator, biased low by the sequential stop at loose ε; see `sss_manylight::estimator`).
-    pub fresh_final: bool,
-    /// The dark-pixel floor F (≥ 0): a pixel also stops once ΔI < ε · F · the frame's bright
-    /// level (see [`DEFAULT_DARK_FLOOR`]); 0 keeps the paper's purely relative criterion.
-    pub dark_floor: f64,
-}
-
-/// The default dark-pixel floor: 10⁻⁶, about 20 stops below the frame's bright level, darker
-/// than any display or tone curve shows. Pixels that dark (in a point-lit head's own shadow,
-/// 10⁻⁸ of the median) otherwise refine to the triplet cap for a relative error nobody sees:
-/// the triplets' bounds ignore visibility, so the refinement splits the shadowed clusters next
-/// to the pixel, whose samples are all 0, long before the faint far ones that carry its value.
-pub const DEFAULT_DARK_FLOOR: f64 = 1e-6;
-
-impl Default for ManyLight {
-    fn default() -> Self {
-        ManyLight {
-            eps: 0.02,
-            alpha: 0.95,
-            selection: Selection::BssrdfAware,
-            vpls: 1024,
-            max_triplets: 200_000,
-            max_splits: 200_000,
-            bounce_paths: 0,
-            vpl_seed: None,
-            stream: 0,
-            fresh_final: true,
-            dark_floor: DEFAULT_DARK_FLOOR,
-        }
-    }
-}
-
-/// The values of `--selection`, as the help and the error list them: `bssrdf` (also spelt
-/// `bssrdf-aware`) and `max-extent`.
-pub const SELECTIONS: [&str; 2] = ["bssrdf", "max-extent"];
-
-/// Parses `--selection` (one of [`SELECTIONS`]; the error lists them).
-pub fn parse_selection(s: &str) -> Result<Selection, Error> {
-    match s.trim() {
-        "bssrdf" | "bssrdf-aware" => Ok(Selection::BssrdfAware),
-        "max-extent" => Ok(Selection::MaxExtent),
-        other => Err(Error::Input(format!(
-            "--selection: unknown value `{other}` (known: {})",
-            SELECTIONS.join(", ")
-        ))),
-    }
-}
-
 impl ManyLight {
     /// The settings `options` describe (errors name the flag).
     pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
-        let eps = eps_option(o, &OPTIONS)?;
-        let alpha = alpha_option(o, &OPTIONS)?;
-        let selection = parse_selection(&o.get::<String>(&OPTIONS, "selection")?)?;
-        let vpls: u32 = o.get(&OPTIONS, "vpls")?;
-        if vpls == 0 {
-            return Err(Error::Input("--vpls must be at least 1".into()));
-        }
-        let max_triplets: usize = o.get(&OPTIONS, "max-triplets")?;
-        if !(1..=(1 << 30)).contains(&max_triplets) {
-            return Err(Error::Input(format!(
-                "--max-triplets must be in 1..=2^30, got {max_triplets}"
-            )));
-        }
-        let bounce_paths: u32 = o.get(&OPTIONS, "bounce-vpls")?;
         let max_splits: usize = o.get(&OPTIONS, "max-splits")?;
         if !(1..=(1 << 30)).contains(&max_splits) {
             return Err(Error::Input(format!(
                 "--max-splits must be in 1..=2^30, got {max_splits}"
             )));
         }
-        let dark_floor: f64 = o.get(&OPTIONS, "dark-floor")?;
-        if !(dark_floor.is_finite() && (0.0..1.0).contains(&dark_floor)) {
-            return Err(Error::Input(format!(
-                "--dark-floor must be in [0, 1), got {dark_floor}"
-            )));
-        }
         Ok(ManyLight {
-            eps,
-            alpha,
-            selection,
-            vpls,
-            max_triplets,
             max_splits,
-            bounce_paths,
-            vpl_seed: None,
-            stream: 0,
+            bounce_paths: o.get(&OPTIONS, "bounce-vpls")?,
             fresh_final: !o.flag("paper-estimate"),
-            dark_floor,
+            ..estimator_options(o, &OPTIONS)?
         })
     }
-}
-
-/// Pixels of the pilot that measures the frame's bright level for the dark-pixel floor.
-pub const PILOT_PIXELS: usize = 32;
-/// ε of the pilot's estimates.
-pub const PILOT_EPS: f64 = 0.2;
-/// Triplet cap of the pilot's estimates.
-pub const PILOT_MAX_TRIPLETS: usize = 4096;
-/// Seed salt of the pilot: its pixels and its estimator stream.
-const PILOT_SEED: u64 = 0x5049_4c4f_5421;
-/// The quantile of the pilot's pixel luminances taken as the frame's bright level.
-pub const BRIGHT_QUANTILE: f64 = 0.9;
-
-/// The bright level of a frame from its pilot pixels' luminances: their
-/// [`BRIGHT_QUANTILE`] quantile (the nearest rank; 0 without pilot pixels), robust to a few
-/// outliers and still set by the lit part where most of the object is in shadow.
-pub fn bright_level(mut lum: Vec<f64>) -> f64 {
-    lum.retain(|v| v.is_finite());
-    if lum.is_empty() {
-        return 0.0;
-    }
-    lum.sort_by(f64::total_cmp);
-    let k = ((BRIGHT_QUANTILE * lum.len() as f64).ceil() as usize).clamp(1, lum.len());
-    lum[k - 1].max(0.0)
-}
-
-/// One pixel's output.
-#[derive(Default)]
-struct PixelOut {
-    values: Vec<Rgb>,
-    triplets: f64,
-    std_error: Rgb,
-    summary: Summary,
 }
 
 impl ManyLight {
@@ -313,162 +144,12 @@ impl ManyLight {
         frame: &Frame<'_>,
         only: Option<&[usize]>,
         progress: &dyn Progress,
-    ) -> Result<(Vec<PixelOut>, Settings, usize, f64), Error> {
-        check_radial(frame, METHOD.name)?;
-        let scene = frame.scene;
-        let objects = frame.timed("irradiance_tree", || object_data(frame, METHOD.name))?;
-        let vpl_seed = self.vpl_seed.unwrap_or(frame.seed);
-        let lights = frame.timed("light_tree", || {
-            light_tree_seeded(frame, self.vpls, self.bounce_paths, vpl_seed)
-        })?;
-        let (_, half_diag) = scene_box(frame);
-        let g_max = Settings::g_max_for_scene(half_diag);
-        let mut settings = Settings::new(g_max);
-        settings.epsilon = self.eps;
-        settings.selection = self.selection;
-        settings.max_triplets = self.max_triplets;
-        settings.max_splits = self.max_splits;
-        settings.min_triplets = MIN_TRIPLETS.min(self.max_triplets);
-        settings.fresh_final = self.fresh_final;
-        let t = StudentT::new(self.alpha).map_err(|e| Error::Input(format!("--alpha: {e}")))?;
-        let estimators = |settings: Settings| -> Result<Vec<Option<Estimator<'_>>>, Error> {
-            Ok(match &lights {
-                None => objects.iter().map(|_| None).collect(),
-                Some(lt) => objects
-                    .iter()
-                    .enumerate()
-                    .map(|(o, d)| {
-                        d.as_ref()
-                            .map(|d| {
-                                Estimator::new(lt, &d.tree, &d.profile, &d.ft, &t, settings)
-                                    .map_err(|e| model_error(scene, o as u32, METHOD.name, e))
-                            })
-                            .transpose()
-                    })
-                    .collect::<Result<_, _>>()?,
-            })
-        };
-        let visibility = shadow_test(frame);
-        let gb = &frame.gbuffer;
-        let list = pixel_list(frame, only, METHOD.name)?;
-        let spp = gb.samples_per_pixel as f64;
-        let max_splits = settings.max_splits;
-        let shade = |estimators: &[Option<Estimator<'_>>],
-                     stream: u64,
-                     refs: &mut Refinements,
-                     i: usize|
-         -> Result<PixelOut, Error> {
-            let samples = gb.pixel(i);
-            let mut out = PixelOut {
-                values: vec![[0.0; 3]; samples.len()],
-                ..PixelOut::default()
-            };
-            let mut var = [0.0; 3];
-            let mut done: Vec<u32> = Vec::new();
-            for g in samples {
-                let o = g.object;
-                if done.contains(&o) {
-                    continue;
-                }
-                done.push(o);
-                let (Some(sh), Some(Some(est))) = (frame.shading_of(o), estimators.get(o as usize))
-                else {
-                    continue;
-                };
-                let mut points = Vec::new();
-                let mut members = Vec::new();
-                for (k, s) in samples.iter().enumerate() {
-                    if s.object == o {
-                        let e = sh.exit_weight(s.n, s.wo);
-                        points.push(ShadingPoint {
-                            position: s.p,
-                            normal: s.n,
-                            weight: e / spp,
-                        });
-                        members.push((k, e));
-                    }
-                }
-                let e_sum: f64 = members.iter().map(|m| m.1).sum();
-                if !(e_sum > 0.0) {
-                    continue;
-                }
-                let tree =
-                    ShadingTree::new(points).map_err(|e| model_error(scene, o, METHOD.name, e))?;
-                let seed = estimate_seed(frame.seed, o, stream, i);
-                let px = est.estimate_with(&tree, &visibility, seed, refs);
-                out.summary.add(&px);
-                out.triplets += px.triplets as f64;
-                for (k, e) in members {
-                    for c in 0..3 {
-                        out.values[k][c] = px.rgb[c].max(0.0) * spp * e / e_sum;
-                    }
-                }
-                // The standard error of the luminance, ΔI / t_α(ν), given to each
-                // channel in proportion to its value.
-                if px.std_error > 0.0 && px.value > 0.0 {
-                    let se = px.std_error;
-                    for c in 0..3 {
-                        let s = px.rgb[c].max(0.0) * se / px.value;
-                        var[c] += s * s;
-                    }
-                }
-            }
-            out.std_error = var.map(f64::sqrt);
-            Ok(out)
-        };
-        // The dark-pixel floor: ε · `dark_floor` · the frame's bright level, measured by a
-        // pilot on a seeded subset of the translucent pixels (the same for a full render and
-        // for any subset of it, on every thread count).
-        if self.dark_floor > 0.0 && settings.epsilon > 0.0 {
-            let level = frame.timed("floor_pilot", || -> Result<f64, Error> {
-                let mut pilot = settings;
-                pilot.epsilon = PILOT_EPS;
-                pilot.max_triplets = PILOT_MAX_TRIPLETS.min(settings.max_triplets);
-                pilot.min_triplets = pilot.min_triplets.min(pilot.max_triplets);
-                let est = estimators(pilot)?;
-                let chosen = crate::metrics::subset_pixels(
-                    &frame.translucent_pixels(),
-                    PILOT_PIXELS,
-                    frame.seed ^ PILOT_SEED,
-                );
-                let lum: Vec<f64> = chosen
-                    .par_iter()
-                    .map_init(
-                        || Refinements::new(max_splits),
-                        |refs, &i| {
-                            shade(&est, PILOT_SEED, refs, i).map(|o| {
-                                let px = pixel_result(
-                                    frame,
-                                    i,
-                                    &o.values,
-                                    o.std_error,
-                                    o.triplets,
-                                    o.summary,
-                                );
-                                sss_manylight::luminance(px.subsurface)
-                            })
-                        },
-                    )
-                    .collect::<Result<_, _>>()?;
-                Ok(bright_level(lum))
-            })?;
-            settings.floor = settings.epsilon * self.dark_floor * level;
-        }
-        let estimators = estimators(settings)?;
-        let pixels: Vec<PixelOut> = frame.timed("shading", || {
-            list.par_iter()
-                .with_min_len(8)
-                .map_init(
-                    || Refinements::new(max_splits),
-                    |refs, &i| {
-                        progress.advance(gb.pixel(i).len() as u64);
-                        shade(&estimators, self.stream, refs, i)
-                    },
-                )
-                .collect::<Result<Vec<PixelOut>, Error>>()
-        })?;
-        let n_vpls = lights.as_ref().map_or(0, |l| l.vpls().len());
-        Ok((pixels, settings, n_vpls, g_max))
+    ) -> Result<(Vec<PixelEstimate>, Settings, usize, f64), Error> {
+        self.with_estimator(frame, METHOD.name, |e| {
+            let list = pixel_list(frame, only, METHOD.name)?;
+            let pixels = frame.timed("shading", || e.estimate(&list, progress))?;
+            Ok((pixels, e.settings, e.vpls, e.g_max))
+        })
     }
 
     /// The estimates of the pixels `pixels` of `frame` only (for subset references and

@@ -1,23 +1,33 @@
 //! The VPL methods: many-light subsurface scattering over virtual point lights. `manylight`
-//! (Nabata & Iwasaki 2021: triplets, Student-t error control) and the two baselines of that
-//! paper, which first draw a fixed set of irradiance points per shading point
-//! ([`gather_points`]: `mdlc`, Walter et al.'s multidimensional lightcuts, and `eelc`, the
-//! paper's error-estimated lightcuts). This module holds what all three share: the light
-//! tree of the frame's VPLs, the per-object data (triangle BVH, radial profile, entry
-//! transmittance), the shadow test, the seeds of pixel estimates and streams, and the
-//! assembly of a subset pixel's result.
+//! (Nabata & Iwasaki 2021: triplets, Student-t error control), `sparse-manylight` (its
+//! estimates on the pixels the screen-space bandwidth of Milaenen et al. 2019 asks for, the
+//! others reconstructed with an interval), and the two baselines of Nabata & Iwasaki, which
+//! first draw a fixed set of irradiance points per shading point ([`gather_points`]: `mdlc`,
+//! Walter et al.'s multidimensional lightcuts, and `eelc`, the paper's error-estimated
+//! lightcuts). This module holds what they share: the light tree of the frame's VPLs, the
+//! per-object data (triangle BVH, radial profile, entry transmittance), the shadow test, the
+//! seeds of pixel estimates and streams, the assembly of a subset pixel's result, and the
+//! many-light estimator of any set of pixels ([`ManyLight::with_estimator`], with its settings
+//! and the dark-pixel floor's pilot).
 
 pub mod gather_points;
 pub mod manylight;
+pub mod sparse_manylight;
 
 use crate::Error;
 use crate::frame::Frame;
+use crate::integrators::check_radial;
+use crate::integrators::options::{alpha_option, eps_option};
+use crate::integrators::{MethodOptions, OptionSpec};
+use crate::progress::Progress;
 use crate::vpls::{bounce_vpls, scene_vpls};
 use glam::DVec3;
+use rayon::prelude::*;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{Rgb, make_model};
 use sss_manylight::{
-    LightTree, RadialProfile, Summary, Transmittance, TriangleClusterTree, pixel_seed,
+    Estimator, LightTree, RadialProfile, Refinements, Selection, Settings, ShadingPoint,
+    ShadingTree, StudentT, Summary, Transmittance, TriangleClusterTree, pixel_seed,
 };
 use sss_scene::Scene;
 
@@ -245,4 +255,392 @@ pub(crate) fn stream_seed(seed: u64, stream: u64) -> u64 {
 pub(crate) fn estimate_seed(frame_seed: u64, o: u32, stream: u64, i: usize) -> u64 {
     let object_seed = stream_seed(frame_seed ^ sss_util::splitmix64(u64::from(o)), stream);
     pixel_seed(sss_util::splitmix64(object_seed), i as u64)
+}
+
+/// The settings of the many-light estimator of Nabata & Iwasaki 2021: the `manylight` method
+/// itself (its registry entry and [`Integrator`](crate::integrators::Integrator) are in
+/// [`manylight`]), and the estimator of the methods built on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ManyLight {
+    /// Relative error threshold ε (≥ 0; 0 refines until a cap).
+    pub eps: f64,
+    /// Confidence level α in (0, 1).
+    pub alpha: f64,
+    /// Cluster selection.
+    pub selection: Selection,
+    /// VPLs per sun, quad or environment light.
+    pub vpls: u32,
+    /// Cap on the triplets per pixel and object.
+    pub max_triplets: usize,
+    /// Cap on the triangle splits per pixel and object.
+    pub max_splits: usize,
+    /// Light paths for one-bounce VPLs ([`crate::vpls::bounce_vpls`]; 0: direct light only).
+    pub bounce_paths: u32,
+    /// Seed of the VPL sampling (`None`: the render's seed). Fixing it keeps one VPL set, and
+    /// so one integral, across renders of different seeds, as the paper's comparisons do.
+    pub vpl_seed: Option<u64>,
+    /// Mixed into every pixel estimate's seed (0 by default): another stream gives an
+    /// independent estimate over the same G-buffer and VPLs (the frame's seed also places the
+    /// camera samples, so changing it changes the pixel values being estimated).
+    pub stream: u64,
+    /// Re-sample the final triplets before reporting (unbiased; `false`: the paper's
+    /// estimator, biased low by the sequential stop at loose ε; see `sss_manylight::estimator`).
+    pub fresh_final: bool,
+    /// The dark-pixel floor F (≥ 0): a pixel also stops once ΔI < ε · F · the frame's bright
+    /// level (see [`DEFAULT_DARK_FLOOR`]); 0 keeps the paper's purely relative criterion.
+    pub dark_floor: f64,
+}
+
+/// The default dark-pixel floor: 10⁻⁶, about 20 stops below the frame's bright level, darker
+/// than any display or tone curve shows. Pixels that dark (in a point-lit head's own shadow,
+/// 10⁻⁸ of the median) otherwise refine to the triplet cap for a relative error nobody sees:
+/// the triplets' bounds ignore visibility, so the refinement splits the shadowed clusters next
+/// to the pixel, whose samples are all 0, long before the faint far ones that carry its value.
+pub const DEFAULT_DARK_FLOOR: f64 = 1e-6;
+
+impl Default for ManyLight {
+    fn default() -> Self {
+        ManyLight {
+            eps: 0.02,
+            alpha: 0.95,
+            selection: Selection::BssrdfAware,
+            vpls: 1024,
+            max_triplets: 200_000,
+            max_splits: 200_000,
+            bounce_paths: 0,
+            vpl_seed: None,
+            stream: 0,
+            fresh_final: true,
+            dark_floor: DEFAULT_DARK_FLOOR,
+        }
+    }
+}
+
+pub use crate::integrators::options::SELECTIONS;
+
+/// Parses `--selection` (one of [`SELECTIONS`]; the error lists them).
+pub fn parse_selection(s: &str) -> Result<Selection, Error> {
+    match s.trim() {
+        "bssrdf" | "bssrdf-aware" => Ok(Selection::BssrdfAware),
+        "max-extent" => Ok(Selection::MaxExtent),
+        other => Err(Error::Input(format!(
+            "--selection: unknown value `{other}` (known: {})",
+            SELECTIONS.join(", ")
+        ))),
+    }
+}
+
+/// The ε values `cargo xtask compare` sweeps for the many-light estimator's methods, loosest
+/// (cheapest) first. Not the paper's 0.02 in the default run: on the slab (a wall's shadow 2
+/// diffusion lengths deep) ε = 0.02 takes 4 minutes of the 20; finer ε goes with
+/// `cargo xtask compare --manylight` and `sss render --eps`.
+pub fn eps_sweep(quick: bool) -> Vec<f64> {
+    if quick {
+        vec![0.1, 0.05]
+    } else {
+        vec![0.2, 0.1, 0.05]
+    }
+}
+
+/// The many-light estimator's settings every method built on it reads from its options (`eps`,
+/// `alpha`, `selection`, `vpls`, `max-triplets`, `dark-floor`; errors name the flag), the
+/// others at their defaults.
+pub(crate) fn estimator_options(
+    o: &MethodOptions,
+    options: &[OptionSpec],
+) -> Result<ManyLight, Error> {
+    let vpls: u32 = o.get(options, "vpls")?;
+    if vpls == 0 {
+        return Err(Error::Input("--vpls must be at least 1".into()));
+    }
+    let max_triplets: usize = o.get(options, "max-triplets")?;
+    if !(1..=(1 << 30)).contains(&max_triplets) {
+        return Err(Error::Input(format!(
+            "--max-triplets must be in 1..=2^30, got {max_triplets}"
+        )));
+    }
+    let dark_floor: f64 = o.get(options, "dark-floor")?;
+    if !(dark_floor.is_finite() && (0.0..1.0).contains(&dark_floor)) {
+        return Err(Error::Input(format!(
+            "--dark-floor must be in [0, 1), got {dark_floor}"
+        )));
+    }
+    Ok(ManyLight {
+        eps: eps_option(o, options)?,
+        alpha: alpha_option(o, options)?,
+        selection: parse_selection(&o.get::<String>(options, "selection")?)?,
+        vpls,
+        max_triplets,
+        dark_floor,
+        ..ManyLight::default()
+    })
+}
+
+/// Pixels of the pilot that measures the frame's bright level for the dark-pixel floor.
+pub const PILOT_PIXELS: usize = 32;
+/// ε of the pilot's estimates.
+pub const PILOT_EPS: f64 = 0.2;
+/// Triplet cap of the pilot's estimates.
+pub const PILOT_MAX_TRIPLETS: usize = 4096;
+/// Seed salt of the pilot: its pixels and its estimator stream.
+const PILOT_SEED: u64 = 0x5049_4c4f_5421;
+/// The quantile of the pilot's pixel luminances taken as the frame's bright level.
+pub const BRIGHT_QUANTILE: f64 = 0.9;
+
+/// The bright level of a frame from its pilot pixels' luminances: their
+/// [`BRIGHT_QUANTILE`] quantile (the nearest rank; 0 without pilot pixels), robust to a few
+/// outliers and still set by the lit part where most of the object is in shadow.
+pub fn bright_level(mut lum: Vec<f64>) -> f64 {
+    lum.retain(|v| v.is_finite());
+    if lum.is_empty() {
+        return 0.0;
+    }
+    lum.sort_by(f64::total_cmp);
+    let k = ((BRIGHT_QUANTILE * lum.len() as f64).ceil() as usize).clamp(1, lum.len());
+    lum[k - 1].max(0.0)
+}
+
+/// One pixel's many-light estimate.
+#[derive(Clone, Debug, Default)]
+pub struct PixelEstimate {
+    /// The value of each of the pixel's G-buffer samples (the estimate of each object split
+    /// over its samples by exit weight; 0 off translucent objects).
+    pub values: Vec<Rgb>,
+    /// The triplets of the pixel's estimates, summed over its objects.
+    pub triplets: f64,
+    /// The standard error of each channel of the pixel's assembled value (ΔI / t_α(ν) of each
+    /// object's estimate, given to the channels in proportion to their values).
+    pub std_error: Rgb,
+    /// The counters of the pixel's estimates.
+    pub summary: Summary,
+}
+
+/// The estimates of a list of pixels, in its order.
+type ShadeFn<'e> =
+    dyn Fn(&[usize], f64, &dyn Progress) -> Result<Vec<PixelEstimate>, Error> + Sync + 'e;
+
+/// Many-light estimates of any pixels of one frame, with what every estimate shares built once
+/// (the light tree, each object's triangle tree, profile and transmittance, the dark-pixel
+/// floor): what [`ManyLight::with_estimator`] hands its closure. A pixel's estimate depends on
+/// its own index and the settings only, never on the other pixels of a call or on the thread
+/// count, so estimating pixels in several calls gives the values of one call.
+pub struct PixelEstimator<'e> {
+    shade: &'e ShadeFn<'e>,
+    /// The estimator's settings, the dark-pixel floor's absolute error included
+    /// ([`Settings::floor`]).
+    pub settings: Settings,
+    /// The VPLs of the light tree.
+    pub vpls: usize,
+    /// The G clamp.
+    pub g_max: f64,
+}
+
+impl PixelEstimator<'_> {
+    /// The estimates of `pixels`, in that order (in parallel; `progress` advances by each
+    /// pixel's G-buffer samples).
+    pub fn estimate(
+        &self,
+        pixels: &[usize],
+        progress: &dyn Progress,
+    ) -> Result<Vec<PixelEstimate>, Error> {
+        (self.shade)(pixels, self.settings.epsilon, progress)
+    }
+
+    /// The estimates of `pixels` at the relative error threshold `eps` instead of the
+    /// settings' (the dark-pixel floor scaled with it), otherwise as [`Self::estimate`]: the
+    /// same seeds, so at the settings' ε the same values.
+    pub fn estimate_at(
+        &self,
+        pixels: &[usize],
+        eps: f64,
+        progress: &dyn Progress,
+    ) -> Result<Vec<PixelEstimate>, Error> {
+        (self.shade)(pixels, eps, progress)
+    }
+}
+
+impl ManyLight {
+    /// Builds what the estimates of `frame` share (light tree, triangle trees, profiles, the
+    /// dark-pixel floor's pilot) and calls `f` with an estimator of any pixels: for `manylight`
+    /// itself and for methods that choose which pixels to estimate as they go. Errors name
+    /// `method`.
+    pub fn with_estimator<R>(
+        &self,
+        frame: &Frame<'_>,
+        method: &str,
+        f: impl FnOnce(&PixelEstimator<'_>) -> Result<R, Error>,
+    ) -> Result<R, Error> {
+        check_radial(frame, method)?;
+        let scene = frame.scene;
+        let objects = frame.timed("irradiance_tree", || object_data(frame, method))?;
+        let vpl_seed = self.vpl_seed.unwrap_or(frame.seed);
+        let lights = frame.timed("light_tree", || {
+            light_tree_seeded(frame, self.vpls, self.bounce_paths, vpl_seed)
+        })?;
+        let (_, half_diag) = scene_box(frame);
+        let g_max = Settings::g_max_for_scene(half_diag);
+        let mut settings = Settings::new(g_max);
+        settings.epsilon = self.eps;
+        settings.selection = self.selection;
+        settings.max_triplets = self.max_triplets;
+        settings.max_splits = self.max_splits;
+        settings.min_triplets = MIN_TRIPLETS.min(self.max_triplets);
+        settings.fresh_final = self.fresh_final;
+        let t = StudentT::new(self.alpha).map_err(|e| Error::Input(format!("--alpha: {e}")))?;
+        let estimators = |settings: Settings| -> Result<Vec<Option<Estimator<'_>>>, Error> {
+            Ok(match &lights {
+                None => objects.iter().map(|_| None).collect(),
+                Some(lt) => objects
+                    .iter()
+                    .enumerate()
+                    .map(|(o, d)| {
+                        d.as_ref()
+                            .map(|d| {
+                                Estimator::new(lt, &d.tree, &d.profile, &d.ft, &t, settings)
+                                    .map_err(|e| model_error(scene, o as u32, method, e))
+                            })
+                            .transpose()
+                    })
+                    .collect::<Result<_, _>>()?,
+            })
+        };
+        let visibility = shadow_test(frame);
+        let gb = &frame.gbuffer;
+        let spp = gb.samples_per_pixel as f64;
+        let max_splits = settings.max_splits;
+        let shade = |estimators: &[Option<Estimator<'_>>],
+                     stream: u64,
+                     refs: &mut Refinements,
+                     i: usize|
+         -> Result<PixelEstimate, Error> {
+            let samples = gb.pixel(i);
+            let mut out = PixelEstimate {
+                values: vec![[0.0; 3]; samples.len()],
+                ..PixelEstimate::default()
+            };
+            let mut var = [0.0; 3];
+            let mut done: Vec<u32> = Vec::new();
+            for g in samples {
+                let o = g.object;
+                if done.contains(&o) {
+                    continue;
+                }
+                done.push(o);
+                let (Some(sh), Some(Some(est))) = (frame.shading_of(o), estimators.get(o as usize))
+                else {
+                    continue;
+                };
+                let mut points = Vec::new();
+                let mut members = Vec::new();
+                for (k, s) in samples.iter().enumerate() {
+                    if s.object == o {
+                        let e = sh.exit_weight(s.n, s.wo);
+                        points.push(ShadingPoint {
+                            position: s.p,
+                            normal: s.n,
+                            weight: e / spp,
+                        });
+                        members.push((k, e));
+                    }
+                }
+                let e_sum: f64 = members.iter().map(|m| m.1).sum();
+                if !(e_sum > 0.0) {
+                    continue;
+                }
+                let tree =
+                    ShadingTree::new(points).map_err(|e| model_error(scene, o, method, e))?;
+                let seed = estimate_seed(frame.seed, o, stream, i);
+                let px = est.estimate_with(&tree, &visibility, seed, refs);
+                out.summary.add(&px);
+                out.triplets += px.triplets as f64;
+                for (k, e) in members {
+                    for c in 0..3 {
+                        out.values[k][c] = px.rgb[c].max(0.0) * spp * e / e_sum;
+                    }
+                }
+                // The standard error of the luminance, ΔI / t_α(ν), given to each
+                // channel in proportion to its value.
+                if px.std_error > 0.0 && px.value > 0.0 {
+                    let se = px.std_error;
+                    for c in 0..3 {
+                        let s = px.rgb[c].max(0.0) * se / px.value;
+                        var[c] += s * s;
+                    }
+                }
+            }
+            out.std_error = var.map(f64::sqrt);
+            Ok(out)
+        };
+        // The dark-pixel floor: ε · `dark_floor` · the frame's bright level, measured by a
+        // pilot on a seeded subset of the translucent pixels (the same for a full render and
+        // for any subset of it, on every thread count).
+        if self.dark_floor > 0.0 && settings.epsilon > 0.0 {
+            let level = frame.timed("floor_pilot", || -> Result<f64, Error> {
+                let mut pilot = settings;
+                pilot.epsilon = PILOT_EPS;
+                pilot.max_triplets = PILOT_MAX_TRIPLETS.min(settings.max_triplets);
+                pilot.min_triplets = pilot.min_triplets.min(pilot.max_triplets);
+                let est = estimators(pilot)?;
+                let chosen = crate::metrics::subset_pixels(
+                    &frame.translucent_pixels(),
+                    PILOT_PIXELS,
+                    frame.seed ^ PILOT_SEED,
+                );
+                let lum: Vec<f64> = chosen
+                    .par_iter()
+                    .map_init(
+                        || Refinements::new(max_splits),
+                        |refs, &i| {
+                            shade(&est, PILOT_SEED, refs, i).map(|o| {
+                                let px = pixel_result(
+                                    frame,
+                                    i,
+                                    &o.values,
+                                    o.std_error,
+                                    o.triplets,
+                                    o.summary,
+                                );
+                                sss_manylight::luminance(px.subsurface)
+                            })
+                        },
+                    )
+                    .collect::<Result<_, _>>()?;
+                Ok(bright_level(lum))
+            })?;
+            settings.floor = settings.epsilon * self.dark_floor * level;
+        }
+        let at_settings = estimators(settings)?;
+        let run = |list: &[usize], eps: f64, progress: &dyn Progress| {
+            // Another ε: the same trees, estimators with that threshold and the floor scaled
+            // with it (ε · F · the bright level).
+            let other;
+            let est = if eps == settings.epsilon {
+                &at_settings
+            } else {
+                let mut s = settings;
+                s.epsilon = eps;
+                if settings.epsilon > 0.0 {
+                    s.floor = settings.floor * eps / settings.epsilon;
+                }
+                other = estimators(s)?;
+                &other
+            };
+            list.par_iter()
+                .with_min_len(8)
+                .map_init(
+                    || Refinements::new(max_splits),
+                    |refs, &i| {
+                        progress.advance(gb.pixel(i).len() as u64);
+                        shade(est, self.stream, refs, i)
+                    },
+                )
+                .collect::<Result<Vec<PixelEstimate>, Error>>()
+        };
+        f(&PixelEstimator {
+            shade: &run,
+            settings,
+            vpls: lights.as_ref().map_or(0, |l| l.vpls().len()),
+            g_max,
+        })
+    }
 }
