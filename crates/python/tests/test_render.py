@@ -208,7 +208,7 @@ def test_ctrl_c_raises_keyboard_interrupt_during_a_render():
 # Every method whose render lasts more than a moment (separable filters the whole frame in
 # a fraction of a second), at a resolution where each takes several seconds on 2 cores.
 STOPPABLE = [(m, {}) for m in ["exact", "pathtrace", "single-tree", "dual-tree", "dual-tree-fmm",
-                                 "manylight", "mdlc", "eelc"]]
+                                 "manylight", "sparse-manylight", "mdlc", "eelc"]]
 STOPPABLE.append(("volpath", {"boundary": "lambertian"}))  # the sphere has a point light
 
 

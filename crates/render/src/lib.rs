@@ -3,10 +3,11 @@
 //! A thin library composing the toolkit's crates behind one integrator interface: ray casting
 //! (one exact BVH per object, `sss-hierarchy`), the G-buffer, direct lighting with shadow rays,
 //! irradiance samples, the [`integrators`] and their registry, image output (EXR, PNG) and
-//! image [`metrics`]. The ten methods come in families (`integrators/`): the point sums
+//! image [`metrics`]. The eleven methods come in families (`integrators/`): the point sums
 //! `exact`, `single-tree`, `dual-tree` and `dual-tree-fmm` (sums over irradiance samples,
-//! exactly or through trees); the VPL methods `manylight`, `mdlc` and `eelc` (many-light
-//! estimators over virtual point lights); the `pathtrace` reference of each model; the
+//! exactly or through trees); the VPL methods `manylight`, `sparse-manylight`, `mdlc` and
+//! `eelc` (many-light estimators over virtual point lights; `sparse-manylight` estimates only
+//! where the screen-space sampling rate of [`sampling_rate`] asks and reconstructs the rest); the `pathtrace` reference of each model; the
 //! screen-space `separable` pass; and `volpath`, volumetric path tracing of the media in the
 //! meshes, the reference of real light transport that no model is bound to. Use it to render a scene from code ([`render`]) or to add a method; the
 //! `sss` binary (crate `sss-cli`) and `cargo xtask compare` are thin layers over it. It pulls in
@@ -60,7 +61,8 @@
 //!   subsurface scattering*: the dual tree with per-pixel sampling rates (`dual-tree`; the
 //!   local-expansion variant `dual-tree-fmm` is this crate's own).
 //! - Nabata & Iwasaki 2021, *Many-light rendering of subsurface scattering with adaptive
-//!   irradiance sampling and error control*: `manylight`, and its baselines Walter et al. 2006
+//!   irradiance sampling and error control*: `manylight` (and, with Milaenen et al.'s sampling
+//!   rates, this crate's own `sparse-manylight`), and its baselines Walter et al. 2006
 //!   (multidimensional lightcuts, `mdlc`) and Sakai et al. 2019 (error estimation for
 //!   lightcuts, `eelc`).
 //! - Pharr, Jakob & Humphreys, *Physically Based Rendering* 3rd ed., §11.4 and §15.4: the
