@@ -8,11 +8,7 @@ use sss_render::progress::NoProgress;
 use sss_render::scene::{LoadOptions, Scene, builtin};
 use sss_render::{RenderSettings, render};
 
-const LUM: [f64; 3] = [0.2126, 0.7152, 0.0722];
-
-fn lum(c: [f64; 3]) -> f64 {
-    LUM[0] * c[0] + LUM[1] * c[1] + LUM[2] * c[2]
-}
+use sss_util::luminance as lum;
 
 fn sphere(w: u32, h: u32) -> Scene {
     let mut s = builtin("sphere", &LoadOptions::default()).unwrap();

@@ -49,7 +49,7 @@
 
 use super::{MIN_TRIPLETS, ManyLight, PixelEstimate, PixelEstimator, eps_sweep, estimator_options};
 use crate::Error;
-use crate::frame::Frame;
+use crate::frame::{Frame, assembled_subsurface};
 use crate::integrators::options::{ALPHA, DARK_FLOOR, MAX_TRIPLETS, SELECTION, VPLS};
 use crate::integrators::{
     Converges, Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat,
@@ -540,6 +540,15 @@ fn reconstruct(
 }
 
 impl SparseManyLight {
+    /// The many-light estimator's settings at the output's ε (lattice points ask for
+    /// `estimate_share` × ε through [`PixelEstimator::estimate_at`]).
+    fn manylight(&self) -> ManyLight {
+        ManyLight {
+            eps: self.eps,
+            ..self.estimator
+        }
+    }
+
     /// The interval's multiplier: the Student-t quantile at α with [`MIN_TRIPLETS`] − 1
     /// degrees of freedom.
     fn t(&self) -> Result<f64, Error> {
@@ -554,6 +563,7 @@ impl SparseManyLight {
         &self,
         frame: &Frame<'_>,
         est: &PixelEstimator<'_>,
+        t: f64,
         progress: &dyn Progress,
     ) -> Result<Shade, Error> {
         let screen = frame.timed("sampling_rate", || Screen::new(frame, self.rate_scale))?;
@@ -563,7 +573,7 @@ impl SparseManyLight {
             floor: est.settings.floor,
             rho: self.rho,
             max_cell: self.max_cell as usize,
-            t: self.t()?,
+            t,
         };
         let mut estimates: Vec<Option<PixelEstimate>> = vec![None; gb.pixels()];
         let eps_lattice = self.eps * self.estimate_share;
@@ -576,7 +586,10 @@ impl SparseManyLight {
             let mut ks = Vec::with_capacity(list.len());
             for (&i, e) in list.iter().zip(est.estimate_at(list, eps, progress)?) {
                 ks.push(Known {
-                    rgb: assembled(&e.values, gb.samples_per_pixel),
+                    rgb: assembled_subsurface(
+                        &e.values.iter().map(|v| Some(*v)).collect::<Vec<_>>(),
+                        gb.samples_per_pixel,
+                    ),
                     se: luminance(e.std_error),
                 });
                 estimates[i] = Some(e);
@@ -601,18 +614,6 @@ impl SparseManyLight {
         );
         Ok((out, estimates, levels))
     }
-}
-
-/// A pixel's subsurface value from its samples' values, as the renderer assembles it.
-fn assembled(values: &[Rgb], samples_per_pixel: u32) -> Rgb {
-    let n = f64::from(samples_per_pixel.max(1));
-    let mut s = [0.0; 3];
-    for v in values {
-        for c in 0..3 {
-            s[c] += v[c] / n;
-        }
-    }
-    s
 }
 
 /// The RGB of a luminance half-width, per channel in proportion to the pixel's value.
@@ -649,8 +650,7 @@ impl Integrator for SparseManyLight {
     }
 
     fn structure_bytes(&self, scene: &Scene, samples: &[(usize, u64, u64)]) -> u64 {
-        let mut m = self.estimator;
-        m.eps = self.eps;
+        let m = self.manylight();
         let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
         // The per-pixel arrays of the lattice (facts, estimates, outputs).
         let lattice = pixels * 160;
@@ -658,15 +658,13 @@ impl Integrator for SparseManyLight {
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
-        let mut m = self.estimator;
-        m.eps = self.eps;
         let gb = &frame.gbuffer;
+        let t = self.t()?;
         let (out, estimates, levels, settings, vpls) =
-            m.with_estimator(frame, METHOD.name, |e| {
-                let (out, estimates, levels) = self.shade(frame, e, progress)?;
+            self.manylight().with_estimator(frame, METHOD.name, |e| {
+                let (out, estimates, levels) = self.shade(frame, e, t, progress)?;
                 Ok((out, estimates, levels, e.settings, e.vpls))
             })?;
-        let t = self.t()?;
         let mut values = vec![[0.0; 3]; gb.samples.len()];
         let n = gb.pixels();
         let mut std_error = vec![[0.0; 3]; n];
