@@ -152,6 +152,12 @@ struct CompareArgs {
     /// (with --trees, both).
     #[arg(long)]
     manylight: bool,
+    /// Run only the sparse many-light experiment: sparse-manylight against manylight on whole
+    /// frames of the many-light scenes and on windows of 1080p frames of the Buddha and the
+    /// head, scored against a path-traced reference (about an hour on 2 cores, minutes with
+    /// --quick).
+    #[arg(long)]
+    sparse: bool,
     /// Run only the truth experiment: every BSSRDF model, the fast methods and volpath itself
     /// against volumetric light transport (volpath's reference) on spheres, the bunny, the
     /// head and the dragon (meshes from the shared meshes) in four media under a quad or an
@@ -361,6 +367,7 @@ fn main() -> ExitCode {
                 quick: args.quick,
                 trees: args.trees,
                 manylight: args.manylight,
+                sparse: args.sparse,
                 truth: args.truth,
                 peers: args.peers,
                 shard: args.shard,

@@ -112,6 +112,10 @@ pub struct Config {
     pub trees: bool,
     /// Run only the paper-scale many-light experiments (module `manylight`).
     pub manylight: bool,
+    /// Run only the sparse many-light experiment: `sparse-manylight` against `manylight` on
+    /// whole frames and on windows of 1080p frames, against a path-traced reference (module
+    /// `manylight::sparse`).
+    pub sparse: bool,
     /// Run only the truth experiment: every model against volumetric light transport (module
     /// `truth`).
     pub truth: bool,
@@ -147,6 +151,7 @@ impl Config {
             quick: false,
             trees: false,
             manylight: false,
+            sparse: false,
             truth: false,
             peers: false,
             shard: None,
@@ -159,7 +164,7 @@ impl Config {
 
     /// True when only flagged experiments run (they use no Monte Carlo reference).
     pub fn paper_only(&self) -> bool {
-        self.trees || self.manylight || self.truth
+        self.trees || self.manylight || self.sparse || self.truth
     }
 
     /// Where references are cached: `--cache`, or `cache/` in the output directory.
@@ -223,7 +228,7 @@ pub trait Experiment {
 pub enum Selection {
     /// In every default run (and in its shards and merges).
     Default,
-    /// Only when asked for by its own flag (`--trees`, `--manylight`, `--truth`): a
+    /// Only when asked for by its own flag (`--trees`, `--manylight`, `--sparse`, `--truth`): a
     /// paper-scale or long experiment, which needs no Monte Carlo reference and runs instead of
     /// the default ones.
     Flag(&'static str),
@@ -275,6 +280,14 @@ pub const EXPERIMENTS: &[ExperimentEntry] = &[
         build: || Box::new(manylight::ManyLightExperiment),
     },
     ExperimentEntry {
+        name: "sparse",
+        about: "sparse-manylight (estimates where s_p asks, the rest reconstructed with an \
+                interval) against manylight on whole frames and 1080p windows, against a \
+                path-traced reference",
+        selection: Selection::Flag("sparse"),
+        build: || Box::new(manylight::sparse::SparseExperiment),
+    },
+    ExperimentEntry {
         name: "truth",
         about: "every model, the fast methods and volpath itself against volumetric light \
                 transport (volpath's reference)",
@@ -289,6 +302,7 @@ fn experiments(config: &Config) -> Vec<Box<dyn Experiment>> {
     let flagged = |f: &str| match f {
         "trees" => config.trees,
         "manylight" => config.manylight,
+        "sparse" => config.sparse,
         "truth" => config.truth,
         _ => false,
     };
@@ -336,7 +350,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
     if sharding && config.paper_only() {
         return Err(Error(
             "--shard, --prepare and --merge split the default experiments; they do not go \
-             with --trees, --manylight or --truth"
+             with --trees, --manylight, --sparse or --truth"
                 .into(),
         ));
     }
@@ -475,6 +489,9 @@ mod registry_tests {
         c.trees = false;
         assert_eq!(names(&c), ["manylight"]);
         c.manylight = false;
+        c.sparse = true;
+        assert_eq!(names(&c), ["sparse"]);
+        c.sparse = false;
         c.truth = true;
         assert_eq!(names(&c), ["truth"]);
     }

@@ -60,6 +60,7 @@ mod reference;
 mod report;
 mod runs;
 mod scoring;
+pub(super) mod sparse;
 #[cfg(test)]
 mod tests;
 

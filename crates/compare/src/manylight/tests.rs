@@ -1,6 +1,8 @@
 //! Tests of the many-light comparison's plan, scoring and tables.
 
 use super::*;
+use sss_bssrdf::Rgb;
+use sss_render::RenderOutput;
 use sss_render::scene::builtin;
 
 /// Area of every translucent triangle of a scene.
@@ -227,4 +229,127 @@ fn table1_reads_equal_quality_and_time_off_the_sweeps() {
 #[test]
 fn every_csv_column_is_documented() {
     assert_eq!(crate::output::undocumented(&csv(&[])), Vec::<String>::new());
+}
+
+/// A window is a centred crop of the 1080p frame: every window pixel's ray is the ray through
+/// the same point of the 1080-row frame (a 1440 × 1080 frame here, the head's 4:3), pixel
+/// for pixel, so its pixels subtend what the frame's do.
+#[test]
+fn a_window_is_the_centre_of_the_1080p_frame() {
+    use sparse::{WINDOW_ROWS, window};
+    use sss_render::camera::CameraFrame;
+    let s = builtin("sphere", &LoadOptions::default()).unwrap();
+    let mut full = s.camera.clone();
+    full.width = 1440;
+    full.height = WINDOW_ROWS;
+    let big = CameraFrame::new(&full);
+    for (w, h) in [(64, 64), (128, 96), (33, 17)] {
+        let win = window(&s, WINDOW_ROWS, w, h);
+        assert_eq!((win.camera.width, win.camera.height), (w, h));
+        assert_eq!(win.camera.pixel_samples, 1);
+        let small = CameraFrame::new(&win.camera);
+        let rel = (small.pixel_angle() / big.pixel_angle() - 1.0).abs();
+        assert!(rel < 1e-12, "{w}x{h}: pixel angle off by {rel}");
+        let (ox, oy) = (0.5 * f64::from(1440 - w), 0.5 * f64::from(WINDOW_ROWS - h));
+        for (x, y) in [
+            (0.0, 0.0),
+            (0.5, 0.5),
+            (f64::from(w), 3.25),
+            (7.5, f64::from(h)),
+        ] {
+            let a = small.direction(x, y);
+            let b = big.direction(x + ox, y + oy);
+            assert!(
+                (a - b).length() < 1e-12,
+                "{w}x{h} at ({x}, {y}): {a} vs {b}"
+            );
+        }
+    }
+}
+
+/// A render's scores on the subset, by hand: within ε, within the interval, reconstructed or
+/// estimated, and the pixels whose reference cannot resolve ε left out.
+#[test]
+fn sparse_scores_count_by_hand() {
+    use sparse::{SparseRow, score_render};
+    // Four pixels of reference luminance 1 (grey), relative standard errors 0, 0, 0, 0.05
+    // (the last does not resolve ε = 2 % and is not scored).
+    let r = Reference {
+        pixels: vec![0, 1, 2, 3],
+        values: vec![[1.0; 3]; 4],
+        rel_se: vec![0.0, 0.0, 0.0, 0.05],
+        ..Reference::default()
+    };
+    let grey = |v: f64| [v; 3];
+    let layer =
+        |name: &'static str, pixels: Vec<Rgb>| sss_render::integrators::Layer { name, pixels };
+    // Pixel 0 estimated at 1.01; 1 reconstructed at 1.03 with interval 0.05 (outside ε, inside
+    // its interval); 2 reconstructed at 0.99 with interval 0.005 (inside ε, outside its
+    // interval); 3 reconstructed, not scored.
+    let out = RenderOutput {
+        method: "sparse-manylight",
+        width: 4,
+        height: 1,
+        subsurface: vec![grey(1.01), grey(1.03), grey(0.99), grey(1.5)],
+        total: vec![grey(0.0); 4],
+        std_error: None,
+        coverage: vec![1.0; 4],
+        alpha: vec![1.0; 4],
+        stages: Vec::new(),
+        stats: vec![
+            sss_render::integrators::Stat {
+                name: "pixels_reconstructed",
+                value: 3.0,
+            },
+            sss_render::integrators::Stat {
+                name: "triplets",
+                value: 400.0,
+            },
+        ],
+        irradiance_samples: 0,
+        irradiance_left_out: 0,
+        spacing: Vec::new(),
+        layers: vec![
+            layer(
+                "estimated",
+                vec![grey(1.0), grey(0.0), grey(0.0), grey(0.0)],
+            ),
+            layer(
+                "interval",
+                vec![grey(0.02), grey(0.05), grey(0.005), grey(0.01)],
+            ),
+        ],
+        warnings: Vec::new(),
+    };
+    let row = score_render(
+        &out,
+        &r,
+        SparseRow {
+            eps: 0.02,
+            translucent: 4,
+            ..SparseRow::default()
+        },
+    );
+    assert_eq!(row.reconstructed, 3);
+    assert!((row.triplets_per_pixel - 100.0).abs() < 1e-12);
+    assert_eq!(row.scored, 3);
+    // Within 2 %: pixels 0 and 2 of the three scored.
+    assert!((row.accuracy - 2.0 / 3.0).abs() < 1e-12, "{}", row.accuracy);
+    assert_eq!(row.scored_reconstructed, 2);
+    assert!((row.accuracy_reconstructed - 0.5).abs() < 1e-12);
+    assert!((row.coverage_reconstructed - 0.5).abs() < 1e-12);
+    // The image mean over all four: (1.01 + 1.03 + 0.99 + 1.5) / 4 − 1.
+    assert!(
+        (row.bias - (4.53 / 4.0 - 1.0)).abs() < 1e-12,
+        "{}",
+        row.bias
+    );
+}
+
+/// Every column of the sparse experiment's CSVs is documented in `docs/compare.md`.
+#[test]
+fn every_sparse_csv_column_is_documented() {
+    use crate::output::undocumented;
+    assert_eq!(undocumented(&sparse::sparse_csv(&[])), Vec::<String>::new());
+    assert_eq!(undocumented(&sparse::cells_csv(&[])), Vec::<String>::new());
 }

@@ -2,6 +2,7 @@
 //! where no cell can be reconstructed, `manylight` itself. (The band-limited signals whose
 //! coverage fails with the bandwidth halved are the module's unit tests.)
 
+use sss_render::frame::Frame;
 use sss_render::integrators::Integrator;
 use sss_render::integrators::sparse_manylight::SparseManyLight;
 use sss_render::progress::NoProgress;
@@ -109,6 +110,14 @@ fn reconstructed_pixels_hold_an_independent_reference_within_their_intervals() {
         }
     }
     let n = n_est + n_rec;
+    // Every pixel reconstructed is among those the G-buffer alone says could be.
+    let frame = Frame::prepare(&s, settings.seed);
+    let bound = m.reconstructable_pixels(&frame).unwrap();
+    let outside = (0..estimated.len())
+        .filter(|&i| out.coverage[i] > 0.0 && estimated[i][0] == 0.0)
+        .filter(|i| bound.binary_search(i).is_err())
+        .count();
+    assert_eq!(outside, 0, "of {} reconstructable", bound.len());
     let (cov_rec, cov_est) = (in_rec as f64 / n_rec as f64, in_est as f64 / n_est as f64);
     let mean_rel = rel / n as f64;
     eprintln!(
@@ -149,6 +158,41 @@ fn a_frame_too_coarse_for_any_cell_is_manylight_itself() {
     let b = render(&s, &plain as &dyn Integrator, &settings, &NoProgress).unwrap();
     let reconstructed = a.stats.iter().find(|x| x.name == "pixels_reconstructed");
     assert_eq!(reconstructed.map(|x| x.value), Some(0.0));
+    let frame = Frame::prepare(&s, settings.seed);
+    assert!(sparse.reconstructable_pixels(&frame).unwrap().is_empty());
     assert_eq!(a.subsurface, b.subsurface);
     assert_eq!(a.std_error, b.std_error);
+}
+
+/// The reconstructable pixels, from the G-buffer alone, are what a render reconstructs when
+/// every eligible cell passes its check (an ε no interval exceeds), and grow with ρ; at a real
+/// ε they bound it (the frame test above checks that at ε = 5 %).
+#[test]
+fn reconstructable_pixels_are_what_every_check_passing_reconstructs() {
+    let s = stripe(64, 48);
+    let settings = RenderSettings::default();
+    let frame = Frame::prepare(&s, settings.seed);
+    let mut last = 0;
+    for rho in [0.5, 1.0, 4.0] {
+        let loose = SparseManyLight {
+            eps: 1e3,
+            rho,
+            ..SparseManyLight::default()
+        };
+        let bound = loose.reconstructable_pixels(&frame).unwrap();
+        let out = render(&s, &loose as &dyn Integrator, &settings, &NoProgress).unwrap();
+        let estimated = out.layer("estimated").unwrap();
+        let got: Vec<usize> = (0..estimated.len())
+            .filter(|&i| out.coverage[i] > 0.0 && estimated[i][0] == 0.0)
+            .collect();
+        eprintln!(
+            "rho {rho}: {} reconstructable, {} reconstructed",
+            bound.len(),
+            got.len()
+        );
+        assert_eq!(got, bound, "rho {rho}");
+        assert!(bound.len() >= last, "rho {rho}: {} < {last}", bound.len());
+        last = bound.len();
+    }
+    assert!(last > 0);
 }

@@ -549,6 +549,30 @@ impl SparseManyLight {
         }
     }
 
+    /// The pixels of `frame` (row-major indices, increasing) the lattice could reconstruct:
+    /// those inside a cell that is eligible at some level, every such cell taken as accepted.
+    /// Their count bounds the stat `pixels_reconstructed` of any render of this frame at this
+    /// ρ, whatever ε. From the G-buffer and the sampling rates alone, without a single
+    /// estimate: where there are none the method estimates every pixel as `manylight` does,
+    /// with the same image.
+    pub fn reconstructable_pixels(&self, frame: &Frame<'_>) -> Result<Vec<usize>, Error> {
+        let screen = Screen::new(frame, self.rate_scale)?;
+        let lattice = Lattice {
+            eps: self.eps,
+            floor: 0.0,
+            rho: self.rho,
+            max_cell: self.max_cell as usize,
+            t: 0.0,
+        };
+        // Zero estimates with no error: every eligible cell's discrepancies and intervals are
+        // 0, within the floor, so it is accepted at the first level it is eligible at.
+        let mut zero = |list: &[usize], _: bool| Ok(vec![Known::default(); list.len()]);
+        let (out, _) = reconstruct(&screen, &lattice, |_| false, &mut zero, &|_| {})?;
+        Ok((0..out.len())
+            .filter(|&i| out[i].done && out[i].cell > 0)
+            .collect())
+    }
+
     /// The interval's multiplier: the Student-t quantile at α with [`MIN_TRIPLETS`] − 1
     /// degrees of freedom.
     fn t(&self) -> Result<f64, Error> {
