@@ -268,55 +268,48 @@ fn a_window_is_the_centre_of_the_1080p_frame() {
 }
 
 /// A render's scores on the subset, by hand: within ε, within the interval, reconstructed or
-/// estimated, and the pixels whose reference cannot resolve ε left out.
+/// estimated, and the pixels whose reference cannot resolve ε left out. The counts differ from
+/// their complements (2 of 3, 3 of 4), so a flipped comparison shows.
 #[test]
 fn sparse_scores_count_by_hand() {
     use sparse::{SparseRow, score_render};
-    // Four pixels of reference luminance 1 (grey), relative standard errors 0, 0, 0, 0.05
-    // (the last does not resolve ε = 2 % and is not scored).
+    // Five pixels of reference luminance 2 (grey), relative standard errors 0 but the last,
+    // 0.05, which does not resolve ε = 2 % and is not scored.
     let r = Reference {
-        pixels: vec![0, 1, 2, 3],
-        values: vec![[1.0; 3]; 4],
-        rel_se: vec![0.0, 0.0, 0.0, 0.05],
+        pixels: vec![0, 1, 2, 3, 4],
+        values: vec![[2.0; 3]; 5],
+        rel_se: vec![0.0, 0.0, 0.0, 0.0, 0.05],
         ..Reference::default()
     };
     let grey = |v: f64| [v; 3];
     let layer =
         |name: &'static str, pixels: Vec<Rgb>| sss_render::integrators::Layer { name, pixels };
-    // Pixel 0 estimated at 1.01; 1 reconstructed at 1.03 with interval 0.05 (outside ε, inside
-    // its interval); 2 reconstructed at 0.99 with interval 0.005 (inside ε, outside its
-    // interval); 3 reconstructed, not scored.
+    let stat = |name: &'static str, value: f64| sss_render::integrators::Stat { name, value };
+    // ε × value = 0.04. Pixel 0 estimated at 2.02 (within ε). Reconstructed: 1 at 2.06 with
+    // interval 0.1 (outside ε, inside its interval); 2 at 1.98 with interval 0.01 (inside ε,
+    // outside its interval); 3 at 2.005 with interval 0.02 (inside both); 4 not scored.
     let out = RenderOutput {
         method: "sparse-manylight",
-        width: 4,
+        width: 5,
         height: 1,
-        subsurface: vec![grey(1.01), grey(1.03), grey(0.99), grey(1.5)],
-        total: vec![grey(0.0); 4],
+        subsurface: vec![grey(2.02), grey(2.06), grey(1.98), grey(2.005), grey(3.0)],
+        total: vec![grey(0.0); 5],
         std_error: None,
-        coverage: vec![1.0; 4],
-        alpha: vec![1.0; 4],
+        coverage: vec![1.0; 5],
+        alpha: vec![1.0; 5],
         stages: Vec::new(),
-        stats: vec![
-            sss_render::integrators::Stat {
-                name: "pixels_reconstructed",
-                value: 3.0,
-            },
-            sss_render::integrators::Stat {
-                name: "triplets",
-                value: 400.0,
-            },
-        ],
+        stats: vec![stat("pixels_reconstructed", 4.0), stat("triplets", 500.0)],
         irradiance_samples: 0,
         irradiance_left_out: 0,
         spacing: Vec::new(),
         layers: vec![
             layer(
                 "estimated",
-                vec![grey(1.0), grey(0.0), grey(0.0), grey(0.0)],
+                vec![grey(1.0), grey(0.0), grey(0.0), grey(0.0), grey(0.0)],
             ),
             layer(
                 "interval",
-                vec![grey(0.02), grey(0.05), grey(0.005), grey(0.01)],
+                vec![grey(0.04), grey(0.1), grey(0.01), grey(0.02), grey(0.01)],
             ),
         ],
         warnings: Vec::new(),
@@ -326,21 +319,21 @@ fn sparse_scores_count_by_hand() {
         &r,
         SparseRow {
             eps: 0.02,
-            translucent: 4,
+            translucent: 5,
             ..SparseRow::default()
         },
     );
-    assert_eq!(row.reconstructed, 3);
+    assert_eq!(row.reconstructed, 4);
     assert!((row.triplets_per_pixel - 100.0).abs() < 1e-12);
-    assert_eq!(row.scored, 3);
-    // Within 2 %: pixels 0 and 2 of the three scored.
-    assert!((row.accuracy - 2.0 / 3.0).abs() < 1e-12, "{}", row.accuracy);
-    assert_eq!(row.scored_reconstructed, 2);
-    assert!((row.accuracy_reconstructed - 0.5).abs() < 1e-12);
-    assert!((row.coverage_reconstructed - 0.5).abs() < 1e-12);
-    // The image mean over all four: (1.01 + 1.03 + 0.99 + 1.5) / 4 − 1.
+    assert_eq!(row.scored, 4);
+    // Within 2 % of 2: pixels 0, 2 and 3 of the four scored.
+    assert!((row.accuracy - 0.75).abs() < 1e-12, "{}", row.accuracy);
+    assert_eq!(row.scored_reconstructed, 3);
+    assert!((row.accuracy_reconstructed - 2.0 / 3.0).abs() < 1e-12);
+    assert!((row.coverage_reconstructed - 2.0 / 3.0).abs() < 1e-12);
+    // The image mean over all five: (2.02 + 2.06 + 1.98 + 2.005 + 3) / 10 − 1.
     assert!(
-        (row.bias - (4.53 / 4.0 - 1.0)).abs() < 1e-12,
+        (row.bias - (11.065 / 10.0 - 1.0)).abs() < 1e-12,
         "{}",
         row.bias
     );

@@ -900,6 +900,25 @@ mod tests {
         }
     }
 
+    /// The estimator runs at the output's ε, not at its own settings' (which the struct
+    /// documents as ignored): its dark-pixel floor, which the lattice's acceptance reads, is
+    /// ε × dark floor × bright level, so it must scale with the output's ε.
+    #[test]
+    fn the_estimator_takes_the_outputs_eps() {
+        for eps in [1e-3, 0.05, 0.5] {
+            let m = SparseManyLight {
+                eps,
+                estimator: ManyLight {
+                    eps: 0.3,
+                    ..ManyLight::default()
+                },
+                ..SparseManyLight::default()
+            };
+            assert_eq!(m.manylight().eps, eps);
+            assert_eq!(m.manylight().vpls, m.estimator.vpls);
+        }
+    }
+
     #[test]
     fn summed_area_counts_equal_brute_force() {
         let (w, h) = (7, 5);
