@@ -238,11 +238,13 @@ fn score_frame(
     let translucent = translucent_pixels(&frame);
     let cam = &scene.camera;
     let mut can = Vec::new();
+    // The pixels the last (largest) ρ could reconstruct, kept for the subset below.
+    let mut widest = Vec::new();
     for &rho in &sp.rhos {
-        let n = sparse_at(ctx, sp.fixed_eps, rho, stream)
+        widest = sparse_at(ctx, sp.fixed_eps, rho, stream)
             .reconstructable_pixels(&frame)
-            .map_err(e)?
-            .len();
+            .map_err(e)?;
+        let n = widest.len();
         (ctx.log)(&format!(
             "sparse: {name} {}x{}: {n} of {} translucent pixels reconstructable at ρ = {rho}",
             cam.width,
@@ -267,12 +269,10 @@ fn score_frame(
     // largest ρ could reconstruct.
     let p = &sp.base;
     let mut pixels = subset_pixels(&translucent, p.subset, seed ^ 0x4d4c);
-    let widest = sparse_at(ctx, sp.fixed_eps, *sp.rhos.last().unwrap_or(&1.0), stream);
+    // `subset_pixels` returns its pixels sorted.
     let pool: Vec<usize> = widest
-        .reconstructable_pixels(&frame)
-        .map_err(e)?
         .into_iter()
-        .filter(|i| !pixels.contains(i))
+        .filter(|i| pixels.binary_search(i).is_err())
         .collect();
     pixels.extend(subset_pixels(&pool, p.subset, seed ^ 0x5350));
     (ctx.log)(&format!(
