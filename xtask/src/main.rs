@@ -164,6 +164,13 @@ struct CompareArgs {
     /// environment light; about an hour on 2 cores, a minute with --quick.
     #[arg(long)]
     truth: bool,
+    /// Run only the deficit experiment: where the BSSRDF models' error against volumetric
+    /// light transport comes from (incidence and exit angles on a half-space, slabs lit from
+    /// behind and from the front, spheres of 2-160 mm, the bunny and the dragon scaled 1-16
+    /// times, single scattering's share), each image mean to 0.5 % (about 20 minutes on 2
+    /// cores; under a minute with --quick).
+    #[arg(long)]
+    deficit: bool,
     /// With --truth: render every case with Mitsuba 3 and Blender Cycles too (their Python
     /// packages, found through SSS_PEERS_PYTHON or python3), on the same axes; a peer whose
     /// package is missing is skipped with a sentence saying how to install it.
@@ -369,6 +376,7 @@ fn main() -> ExitCode {
                 manylight: args.manylight,
                 sparse: args.sparse,
                 truth: args.truth,
+                deficit: args.deficit,
                 peers: args.peers,
                 shard: args.shard,
                 merge: args.merge,

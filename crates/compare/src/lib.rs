@@ -119,6 +119,9 @@ pub struct Config {
     /// Run only the truth experiment: every model against volumetric light transport (module
     /// `truth`).
     pub truth: bool,
+    /// Run only the deficit experiment: where the models' error against volumetric light
+    /// transport comes from, on controlled set-ups (module `truth::deficit`).
+    pub deficit: bool,
     /// With `truth`: render its cases with the peers too (Mitsuba 3), when installed.
     pub peers: bool,
     /// Run only this share of the default experiments (module `shard`).
@@ -153,6 +156,7 @@ impl Config {
             manylight: false,
             sparse: false,
             truth: false,
+            deficit: false,
             peers: false,
             shard: None,
             merge: Vec::new(),
@@ -164,7 +168,7 @@ impl Config {
 
     /// True when only flagged experiments run (they use no Monte Carlo reference).
     pub fn paper_only(&self) -> bool {
-        self.trees || self.manylight || self.sparse || self.truth
+        self.trees || self.manylight || self.sparse || self.truth || self.deficit
     }
 
     /// Where references are cached: `--cache`, or `cache/` in the output directory.
@@ -228,7 +232,8 @@ pub trait Experiment {
 pub enum Selection {
     /// In every default run (and in its shards and merges).
     Default,
-    /// Only when asked for by its own flag (`--trees`, `--manylight`, `--sparse`, `--truth`): a
+    /// Only when asked for by its own flag (`--trees`, `--manylight`, `--sparse`, `--truth`,
+    /// `--deficit`): a
     /// paper-scale or long experiment, which needs no Monte Carlo reference and runs instead of
     /// the default ones.
     Flag(&'static str),
@@ -294,6 +299,14 @@ pub const EXPERIMENTS: &[ExperimentEntry] = &[
         selection: Selection::Flag("truth"),
         build: || Box::new(truth::TruthExperiment),
     },
+    ExperimentEntry {
+        name: "deficit",
+        about: "where the models' error against volumetric light transport comes from: \
+                incidence and exit angles, thin slabs, curvature and object size, single \
+                scattering, on controlled set-ups",
+        selection: Selection::Flag("deficit"),
+        build: || Box::new(truth::deficit::DeficitExperiment),
+    },
 ];
 
 /// The experiments `config` selects, in report order: those whose flag it sets, or the
@@ -304,6 +317,7 @@ fn experiments(config: &Config) -> Vec<Box<dyn Experiment>> {
         "manylight" => config.manylight,
         "sparse" => config.sparse,
         "truth" => config.truth,
+        "deficit" => config.deficit,
         _ => false,
     };
     EXPERIMENTS
@@ -350,7 +364,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
     if sharding && config.paper_only() {
         return Err(Error(
             "--shard, --prepare and --merge split the default experiments; they do not go \
-             with --trees, --manylight, --sparse or --truth"
+             with --trees, --manylight, --sparse, --truth or --deficit"
                 .into(),
         ));
     }
@@ -494,5 +508,9 @@ mod registry_tests {
         c.sparse = false;
         c.truth = true;
         assert_eq!(names(&c), ["truth"]);
+        c.deficit = true;
+        assert_eq!(names(&c), ["truth", "deficit"]);
+        c.truth = false;
+        assert_eq!(names(&c), ["deficit"]);
     }
 }

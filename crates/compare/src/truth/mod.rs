@@ -24,7 +24,11 @@
 //!
 //! Writes `truth.csv` (columns in `docs/compare.md`), `truth_error_vs_time_<case>.png` and
 //! under `truth/<case>/` the pictures ([`images`]).
+//!
+//! `--deficit` ([`deficit`]) uses the same media and scenes to measure where the models'
+//! error against this truth comes from.
 
+pub(crate) mod deficit;
 mod images;
 mod peers;
 mod plan;

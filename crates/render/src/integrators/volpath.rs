@@ -23,6 +23,9 @@
 //!   the refracted ray never samples; Mitsuba 3's image is black there too): such a scene is
 //!   refused with an error naming `--boundary lambertian`, which reaches them by next-event
 //!   estimation, never rendered silently black.
+//! - Scattering orders: `--scattering single` or `multiple` keeps only the light whose path
+//!   collided once, or two times or more, in the media ([`Scattering`]), so the share of each
+//!   order in real transport can be measured (`cargo xtask compare --deficit`).
 //! - The rest of the scene (diffuse surfaces, their shadows, the background) is lit as for
 //!   every method, by `render`'s direct light, so whole images compare.
 //!
@@ -31,6 +34,7 @@
 //! is seeded by its G-buffer sample, so images are bit-identical for any thread count.
 
 pub use crate::volume::boundary::Boundary;
+pub use crate::volume::walk::Scattering;
 
 use super::{
     Converges, Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
@@ -48,7 +52,7 @@ use sss_bssrdf::Rgb;
 use sss_scene::{Light, Scene};
 
 /// The options of `volpath`.
-pub const OPTIONS: [OptionSpec; 4] = [
+pub const OPTIONS: [OptionSpec; 5] = [
     OptionSpec {
         name: "spp",
         value_name: "N",
@@ -85,6 +89,16 @@ pub const OPTIONS: [OptionSpec; 4] = [
                cap darkens the image, counted in the stat capped_paths)",
         kind: OptionKind::Value,
         values: &[],
+    },
+    OptionSpec {
+        name: "scattering",
+        value_name: "ORDERS",
+        default: "all",
+        help: "Which light the image holds, by the collisions of its path in the media: `all`, \
+               `single` (exactly one collision) or `multiple` (two or more); light that \
+               crossed a medium without a collision is only in `all`",
+        kind: OptionKind::Value,
+        values: &["all", "single", "multiple"],
     },
 ];
 
@@ -142,6 +156,8 @@ pub struct VolPath {
     pub g: Option<f64>,
     /// Events per path before it is stopped (None: no cap).
     pub max_events: Option<u64>,
+    /// Which scattering orders the image holds.
+    pub scattering: Scattering,
 }
 
 impl Default for VolPath {
@@ -151,6 +167,7 @@ impl Default for VolPath {
             boundary: Boundary::Dielectric,
             g: None,
             max_events: None,
+            scattering: Scattering::All,
         }
     }
 }
@@ -185,11 +202,22 @@ impl VolPath {
                 "--max-events must be at least 1 (or `none`)".into(),
             ));
         }
+        let scattering = match o.get::<String>(&OPTIONS, "scattering")?.as_str() {
+            "all" => Scattering::All,
+            "single" => Scattering::Single,
+            "multiple" => Scattering::Multiple,
+            other => {
+                return Err(Error::Input(format!(
+                    "--scattering: `{other}` is not one of all, single, multiple"
+                )));
+            }
+        };
         Ok(VolPath {
             spp,
             boundary,
             g,
             max_events,
+            scattering,
         })
     }
 
@@ -223,13 +251,14 @@ impl Integrator for VolPath {
 
     fn describe(&self) -> String {
         format!(
-            "paths per pixel sample: {}, boundary {}, g {}, max events {}",
+            "paths per pixel sample: {}, boundary {}, g {}, max events {}, scattering {}",
             self.spp,
             self.boundary.name(),
             self.g
                 .map_or("of the material".to_string(), |g| g.to_string()),
             self.max_events
-                .map_or("none".to_string(), |n| n.to_string())
+                .map_or("none".to_string(), |n| n.to_string()),
+            self.scattering.name()
         )
     }
 
@@ -246,6 +275,7 @@ impl Integrator for VolPath {
             emitters: &emitters,
             boundary: self.boundary,
             max_events: self.max_events,
+            scattering: self.scattering,
         };
         let spp = self.spp.max(1);
         let gspp = frame.gbuffer.samples_per_pixel as u64;

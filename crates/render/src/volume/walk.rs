@@ -10,7 +10,9 @@
 //!   hero channel ([`super::spectral`]), collisions scattered by Henyey–Greenstein, Russian
 //!   roulette on the path weight (the camera vertex's transmittance left out) once it falls
 //!   below 1. No cap on the number of collisions
-//!   unless `--max-events` sets one.
+//!   unless `--max-events` sets one. With `--scattering single` or `multiple`, light reaching
+//!   the path counts only if the path's collisions so far are of those orders ([`Scattering`];
+//!   a single-scattering path ends at its second collision).
 //! - **At the boundary from inside**, dielectric: reflected with probability F (total
 //!   internal reflection included), refracted out otherwise; the pre-scatter texture is
 //!   applied where the light leaves (where, following the light, it entered). Lambertian: the
@@ -65,6 +67,40 @@ impl WalkCounts {
     }
 }
 
+/// Which light a path's estimate keeps, by its collisions in the media (the classic split of
+/// subsurface light into single and multiple scattering, Hanrahan & Krueger 1993; Jensen et
+/// al. 2001 §3): the part of the image each order carries, in real transport.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Scattering {
+    /// Every path (the image).
+    #[default]
+    All,
+    /// Paths with exactly one collision.
+    Single,
+    /// Paths with two collisions or more.
+    Multiple,
+}
+
+impl Scattering {
+    /// The option's value naming it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scattering::All => "all",
+            Scattering::Single => "single",
+            Scattering::Multiple => "multiple",
+        }
+    }
+
+    /// Whether light that reached the camera after `collisions` collisions counts.
+    pub fn keeps(self, collisions: u64) -> bool {
+        match self {
+            Scattering::All => true,
+            Scattering::Single => collisions == 1,
+            Scattering::Multiple => collisions >= 2,
+        }
+    }
+}
+
 /// Everything a path reads.
 pub struct Walker<'a> {
     /// The scene (objects' materials).
@@ -79,6 +115,8 @@ pub struct Walker<'a> {
     pub boundary: Boundary,
     /// Collisions and interface events per path before it is stopped (None: no cap).
     pub max_events: Option<u64>,
+    /// Which scattering orders the estimate keeps.
+    pub scattering: Scattering,
 }
 
 /// Where the path is.
@@ -168,6 +206,16 @@ impl Walker<'_> {
     ) -> Rgb {
         let mut acc = [0.0; 3];
         let mut events = 0u64;
+        // Collisions so far, for `scattering`: light is kept where it reaches the path only if
+        // the path's collisions up to there are of the orders asked for.
+        let mut collisions = 0u64;
+        let kept = |collisions: u64| {
+            if self.scattering.keeps(collisions) {
+                1.0
+            } else {
+                0.0
+            }
+        };
         loop {
             if let Some(cap) = self.max_events
                 && events >= cap
@@ -200,6 +248,11 @@ impl Walker<'_> {
                             }
                             events += 1;
                             counts.collisions += 1;
+                            collisions += 1;
+                            // Single scattering needs nothing past the first collision.
+                            if self.scattering == Scattering::Single && collisions > 1 {
+                                return acc;
+                            }
                             w.scatter(med.sigma_s, med.sigma_t, t);
                             p = origin + dir * t;
                             ng = None;
@@ -233,8 +286,9 @@ impl Walker<'_> {
                                     let e = self.exit_light(p, hit.n, hit.ng, rng, packets);
                                     let tex = med.texture_at(p);
                                     let wt = w.weight();
+                                    let k = kept(collisions);
                                     for c in 0..3 {
-                                        acc[c] += wt[c] * tex[c] * e[c];
+                                        acc[c] += k * wt[c] * tex[c] * e[c];
                                     }
                                     return acc;
                                 }
@@ -252,14 +306,16 @@ impl Walker<'_> {
                             le[c] += env[c];
                         }
                         let wt = w.weight();
+                        let k = kept(collisions);
                         for c in 0..3 {
-                            acc[c] += wt[c] * le[c];
+                            acc[c] += k * wt[c] * le[c];
                         }
                         return acc;
                     };
                     let wt = w.weight();
+                    let k = kept(collisions);
                     for c in 0..3 {
-                        acc[c] += wt[c] * le[c];
+                        acc[c] += k * wt[c] * le[c];
                     }
                     // An opaque surface ends the path (and the Lambertian boundary never
                     // leaves a path outside).

@@ -196,6 +196,7 @@ fn bad_options_are_one_line_errors() {
         ("g", "forward", "neither `material` nor a number"),
         ("max-events", "0", "at least 1"),
         ("max-events", "-3", "neither `none` nor a whole number"),
+        ("scattering", "double", "all, single, multiple"),
     ] {
         let e = integrators::build("volpath", &MethodOptions::new().with(k, v))
             .err()
@@ -233,4 +234,105 @@ fn a_binding_event_cap_darkens_and_warns() {
         .filter(|(g, v)| v[0] < ft_dielectric(g.n.dot(g.wo), 1.3) - 1e-9)
         .count();
     assert!(dark > 0);
+}
+
+/// A half-space (the front face of a 400 mm block) of an index-matched medium (η = 1), albedo
+/// 1/2, isotropic scattering, under a sun of 20° at normal incidence, seen at 45° at 32 × 32.
+fn index_matched_half_space() -> Scene {
+    let text = r#"
+[camera]
+position = [42.42640687119285, 0.0, 42.42640687119285]
+target = [0.0, 0.0, 0.0]
+fov = 10.0
+resolution = [32, 32]
+
+[[lights]]
+type = "sun"
+direction = [0.0, 0.0, -1.0]
+irradiance = 1.0
+angular_diameter = 20.0
+
+[materials.m]
+type = "translucent"
+model = "standard-dipole"
+sigma_a = 1.0
+sigma_s = 1.0
+eta = 1.0
+units_per_mm = 1.0
+
+[[objects]]
+name = "block"
+material = "m"
+shape = "box"
+size = [400.0, 400.0, 100.0]
+transform = { translate = [0.0, 0.0, -50.0] }
+"#;
+    sss_render::scene::load_str(text, "half-space.toml", None, &Default::default()).unwrap()
+}
+
+/// `volpath --scattering ORDERS` on `scene`: the image mean over every pixel and its standard
+/// error.
+fn mean_of(scene: &Scene, scattering: &str, spp: u32, seed: u64) -> (f64, f64) {
+    let m = volpath(
+        MethodOptions::new()
+            .with("spp", spp)
+            .with("scattering", scattering),
+    );
+    let settings = sss_render::RenderSettings {
+        seed,
+        ..Default::default()
+    };
+    let out = sss_render::render(scene, m.as_ref(), &settings, &NoProgress).unwrap();
+    let se = out.std_error.unwrap();
+    let n = out.subsurface.len() as f64;
+    let mean = out.subsurface.iter().map(|v| v[0]).sum::<f64>() / n;
+    let var: f64 = se.iter().map(|s| s[0] * s[0]).sum();
+    (mean, var.sqrt() / n)
+}
+
+/// Single scattering from an index-matched half-space has a closed form (Chandrasekhar 1960;
+/// Hanrahan & Krueger 1993, Eq. 21 with isotropic phase): a beam of power E⊥ per unit area
+/// across it, at μ₀ = cos θ_i, leaves L = α E⊥ μ₀ / (4π (μ₀ + μ)) at μ = cos θ_o. Summed over
+/// the sun's disc (radiance E/(π sin²(δ/2))), `--scattering single` must give it; and the
+/// image must be the sum of its single and multiple scattering (nothing reaches this camera
+/// unscattered).
+#[test]
+fn single_scattering_matches_its_closed_form_and_the_orders_add_up() {
+    let scene = index_matched_half_space();
+    let (alpha, mu) = (0.5, std::f64::consts::FRAC_1_SQRT_2);
+    let half = 10f64.to_radians();
+    let l_sun = 1.0 / (std::f64::consts::PI * half.sin().powi(2));
+    // ∫ over the disc of μ₀/(μ₀ + μ) dω: Simpson's rule in θ over [0, δ/2].
+    let f = |t: f64| 2.0 * std::f64::consts::PI * t.sin() * t.cos() / (t.cos() + mu);
+    let k = 200;
+    let h = half / k as f64;
+    let integral = h / 3.0
+        * (0..=k)
+            .map(|i| {
+                let w = if i == 0 || i == k {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * f(i as f64 * h)
+            })
+            .sum::<f64>();
+    let want = alpha / (4.0 * std::f64::consts::PI) * l_sun * integral;
+    let (single, se) = mean_of(&scene, "single", 4096, 7);
+    assert!(se < 0.012 * want, "too noisy to test: {se} of {want}");
+    eprintln!("single scattering {single} ± {se}, closed form {want}");
+    assert!(
+        (single - want).abs() < 4.0 * se,
+        "single scattering {single} ± {se}, closed form {want}"
+    );
+    let (all, se_a) = mean_of(&scene, "all", 256, 8);
+    let (multiple, se_m) = mean_of(&scene, "multiple", 256, 9);
+    let se_sum = (se_a * se_a + se_m * se_m + se * se).sqrt();
+    assert!(multiple > 0.1 * all, "multiple {multiple} of {all}");
+    assert!(
+        (all - single - multiple).abs() < 4.0 * se_sum,
+        "all {all} ≠ single {single} + multiple {multiple} (± {se_sum})"
+    );
 }
