@@ -31,6 +31,10 @@
 //! - The full BSSRDF of the separable models is, as in pbrt (3rd ed. §11.4 and §15.4),
 //!   S = F_t(η, ω_o) · R_d(‖x_o − x_i‖) · F_t(η, ω_i) / (c π), c = 1 − 2 C₁(η).
 //! - Fresnel `eta` arguments are n_t / n_i; see [`fresnel`].
+//! - [`angular`] gives the half-space's directional albedo A(θ) from the same walk at
+//!   oblique incidence ([`DirectionalAlbedo`]); with it the angular factors become
+//!   F_t(η, 1) A(θ_i)/A(0°) and A(θ_o)/(πĀ), which a renderer may use instead (the scene
+//!   format's `angular = "albedo"`).
 //!
 //! ## Papers implemented
 //! - Jensen, Marschner, Levoy, Hanrahan. *A Practical Model for Subsurface Light Transport.*
@@ -49,9 +53,13 @@
 //!   condensed walk of Graaff et al., *Condensed Monte Carlo simulations for the description
 //!   of light transport*, Appl. Opt. 32(4), 1993 ([`monte_carlo::condensed`]) as the
 //!   `mc-table` model ([`McTableModel`]).
+//! - Chandrasekhar. *Radiative Transfer.* 1960, §V — the H function and the plane albedo
+//!   1 − H(μ₀)√(1 − ω) of an isotropic, index-matched half-space, the closed form
+//!   [`angular`]'s walk is tested against.
 
 #![forbid(unsafe_code)]
 
+pub mod angular;
 pub mod better_dipole;
 pub mod catmull_rom;
 pub mod christensen_burley;
@@ -73,6 +81,7 @@ pub mod standard_dipole;
 use std::fmt;
 use std::str::FromStr;
 
+pub use angular::DirectionalAlbedo;
 pub use better_dipole::BetterDipole;
 pub use christensen_burley::{BurleyFit, ChristensenBurley};
 pub use directional_dipole::DirectionalDipole;

@@ -271,6 +271,11 @@ struct Walk<'a> {
     g: f64,
     /// n_t / n_i for light leaving the medium: 1/η.
     eta_out: f64,
+    /// Analog absorption (the photon dies with probability 1 − α at a collision, its weight
+    /// unchanged) instead of implicit absorption (its weight times α): walks as long as the
+    /// light lives, not until the weight falls to the roulette's threshold (near α = 1
+    /// thousands of collisions fewer; noisier per photon).
+    analog: bool,
     max_events: u64,
     /// 1 / bin width (linear bins).
     inv_dr: f64,
@@ -431,16 +436,18 @@ fn scatter_direction(d: DVec3, cos_theta: f64, cos_phi: f64, sin_phi: f64) -> DV
     n * n.length_squared().sqrt().recip()
 }
 
-/// Traces one photon, calling `escape(r, weight, collisions)` for every weight that leaves
+/// Traces one photon that starts at the origin heading along `start` (a unit vector into the
+/// medium, d_z < 0), calling `escape(r, weight, collisions)` for every weight that leaves
 /// through the boundary at radius `r` after `collisions` collisions. Returns `Some(weight)` if
 /// it hit the event cap still carrying `weight`.
 fn trace_photon(
     walk: &Walk,
+    start: DVec3,
     rng: &mut Pcg64Mcg,
     escape: &mut impl FnMut(f64, f64, u64),
 ) -> Option<f64> {
     let mut p = DVec3::ZERO;
-    let mut d = DVec3::NEG_Z;
+    let mut d = start;
     let mut w = 1.0_f64;
     let mut events = 0_u64;
     loop {
@@ -476,7 +483,14 @@ fn trace_photon(
         if events > walk.max_events {
             return Some(w);
         }
-        w *= walk.albedo;
+        if walk.analog {
+            // Analog absorption: the photon survives the collision with probability α.
+            if uniform(rng) >= walk.albedo {
+                return None;
+            }
+        } else {
+            w *= walk.albedo;
+        }
         if w < ROULETTE_THRESHOLD {
             if w <= 0.0 || uniform(rng) >= ROULETTE_SURVIVAL {
                 return None;
@@ -500,7 +514,7 @@ fn run_chunk(walk: &Walk, photons: u64, seed: u64) -> Tally {
         total: 0.0,
     };
     for _ in 0..photons {
-        let traced = trace_photon(walk, &mut rng, &mut |r, w, events| {
+        let traced = trace_photon(walk, DVec3::NEG_Z, &mut rng, &mut |r, w, events| {
             scratch.deposit(walk, r, w);
             if events == 1 {
                 scratch.deposit_single(walk, r, w);
@@ -515,6 +529,38 @@ fn run_chunk(walk: &Walk, photons: u64, seed: u64) -> Tally {
     tally.single = std::mem::take(&mut scratch.single);
     tally.single_total = scratch.single_total;
     tally
+}
+
+/// One photon's walk in a half-space of single-scattering albedo `albedo`, in units of the
+/// mean free path (σ_t = 1), with Henyey–Greenstein `g` under a boundary of relative index
+/// `eta`, starting at the boundary heading along `start` (unit, d_z < 0) with weight 1: the
+/// walk of [`simulate`] (Fresnel splitting at the boundary, the event cap) with analog
+/// absorption. Calls `escape(collisions, weight)` for each weight leaving. A half-space has
+/// no length of its own, so a medium of albedo α ≤ `albedo` returns Σ weight · (α/albedo)ⁿ
+/// over the same walks (n collisions): one walk at the largest albedo serves every channel
+/// (the condensed Monte Carlo of Graaff et al. 1993). Used by
+/// [`crate::angular::DirectionalAlbedo`].
+pub(crate) fn condensed_escapes(
+    albedo: f64,
+    g: f64,
+    eta: f64,
+    start: DVec3,
+    rng: &mut Pcg64Mcg,
+    escape: &mut impl FnMut(u64, f64),
+) {
+    let walk = Walk {
+        sigma_t: 1.0,
+        albedo: albedo.clamp(0.0, 1.0),
+        g,
+        eta_out: 1.0 / eta,
+        analog: true,
+        max_events: MAX_SCATTERING_EVENTS,
+        inv_dr: 0.0,
+        r_max: 0.0,
+        bins: 1,
+        edges: None,
+    };
+    trace_photon(&walk, start, rng, &mut |_, w, n| escape(n, w));
 }
 
 /// Standard error of the mean of N samples with sums `s`, `s2`.
@@ -554,6 +600,7 @@ pub(crate) fn simulate_impl(
         albedo: medium.albedo(ch).clamp(0.0, 1.0),
         g: medium.g(),
         eta_out: 1.0 / medium.eta(),
+        analog: false,
         max_events,
         inv_dr: 1.0 / dr,
         r_max: cfg.r_max,

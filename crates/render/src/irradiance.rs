@@ -19,7 +19,7 @@
 use crate::geometry::{SceneGeometry, triangles_of};
 use crate::lights::{Incident, Receiver, gather};
 use crate::rng::{Stream, rng};
-use crate::shading::transmitted_irradiance;
+use crate::shading::BoundaryWeights;
 use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::{ModelKind, Rgb};
@@ -251,7 +251,7 @@ fn compute_within(
                 _ => 0,
             };
             let directional = mat.model == ModelKind::DirectionalDipole;
-            let eta = medium.eta();
+            let weights = BoundaryWeights::of(mat);
             let lit: Vec<(IrradianceSample, Vec<Incident>)> = points
                 .par_iter()
                 .enumerate()
@@ -286,7 +286,7 @@ fn compute_within(
                         .texture
                         .as_ref()
                         .map_or([1.0; 3], |t| t.eval(s.position));
-                    let e = transmitted_irradiance(&mut inc, n, eta, tex);
+                    let e = weights.entering(&mut inc, n, tex);
                     let sample = IrradianceSample {
                         position: s.position,
                         normal: n,

@@ -11,7 +11,7 @@
 use crate::gbuffer::GSample;
 use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::lights::{Incident, Receiver, gather, tangent_frame};
-use crate::shading::{TranslucentShading, transmitted_irradiance};
+use crate::shading::TranslucentShading;
 use glam::DVec3;
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
@@ -326,11 +326,11 @@ impl Sampler<'_> {
                 }
             }
         } else {
-            let e = transmitted_irradiance(packets, pi.n, shading.eta, tex);
+            let e = shading.weights.entering(packets, pi.n, tex);
             let rd = shading.rd_scene((pi.p - g.p).length());
-            let w = shading.exit_weight(g.n, g.wo) / pdf;
+            let w = shading.exit_weights(g.n, g.wo);
             for c in 0..3 {
-                out[c] = rd[c] * e[c] * w;
+                out[c] = rd[c] * e[c] * (w[c] / pdf);
             }
         }
         if out.iter().all(|v| v.is_finite()) {

@@ -2,7 +2,8 @@
 //! shading time ([`TranslucentShading`]), the split between radial models and the full S of
 //! the directional dipole ([`ShadingModel`]), the Fresnel-transmitted, textured irradiance
 //! entering the surface ([`transmitted_irradiance`]) and the exit weight F_t(η, cos θ_o)/(cπ)
-//! ([`TranslucentShading::exit_weight`]).
+//! ([`TranslucentShading::exit_weight`]), or, for a material with `angular = "albedo"`, the
+//! half-space's directional albedo in their place ([`BoundaryWeights`]).
 //!
 //! Every integrator computes (pbrt 3rd ed. Eq. 11.6–11.7, with c = 1 − 2C₁(η) the
 //! normalisation of pbrt's S_ω):
@@ -19,9 +20,82 @@
 use crate::lights::Incident;
 use glam::DVec3;
 use sss_bssrdf::fresnel::ft_dielectric;
-use sss_bssrdf::{Bssrdf, ModelKind, Rgb, fresnel_normalization, make_model};
-use sss_scene::{Scene, Texture, Translucent};
+use sss_bssrdf::{Bssrdf, DirectionalAlbedo, ModelKind, Rgb, fresnel_normalization, make_model};
+use sss_scene::{Angular, Scene, Texture, Translucent};
 use std::f64::consts::PI;
+use std::sync::Arc;
+
+/// A radial model's angular factors, S = W_i(θ_i) R_d(r) W_o(θ_o), as the material asks
+/// ([`Angular`]): Fresnel's (every model's own) or the half-space's directional albedo from
+/// the random walk ([`DirectionalAlbedo`]).
+#[derive(Clone, Debug)]
+pub enum BoundaryWeights {
+    /// W_i = F_t(η, cos θ_i), W_o = F_t(η, cos θ_o)/(cπ).
+    Fresnel {
+        /// Relative index of refraction.
+        eta: f64,
+        /// 1/(cπ).
+        norm: f64,
+    },
+    /// W_i = F_t(η, 1) A(θ_i)/A(0°), W_o = A(θ_o)/(πĀ), per channel.
+    Albedo {
+        /// Relative index of refraction.
+        eta: f64,
+        /// A(θ) of the material's medium.
+        table: Arc<DirectionalAlbedo>,
+    },
+}
+
+impl BoundaryWeights {
+    /// The weights of material `t` (the directional albedo walked once per medium and process,
+    /// [`DirectionalAlbedo::cached`]).
+    pub fn of(t: &Translucent) -> Self {
+        let eta = t.medium.eta();
+        match t.angular {
+            Angular::Fresnel => BoundaryWeights::Fresnel {
+                eta,
+                norm: 1.0 / (fresnel_normalization(eta) * PI),
+            },
+            Angular::Albedo => BoundaryWeights::Albedo {
+                eta,
+                table: DirectionalAlbedo::cached(&t.medium),
+            },
+        }
+    }
+
+    /// The irradiance entering the medium at a point with shading normal `n`:
+    /// Σ_k W_i(n·ω_k) E_k · `tex` per channel (for Fresnel's weights exactly
+    /// [`transmitted_irradiance`]). The texture is multiplied into each packet in place.
+    pub fn entering(&self, packets: &mut [Incident], n: DVec3, tex: Rgb) -> Rgb {
+        match self {
+            BoundaryWeights::Fresnel { eta, .. } => transmitted_irradiance(packets, n, *eta, tex),
+            BoundaryWeights::Albedo { eta, table } => {
+                let mut e = [0.0; 3];
+                for packet in packets {
+                    let w = table.entry_weight(n.dot(packet.dir).abs(), *eta);
+                    for c in 0..3 {
+                        packet.e_cos[c] *= tex[c];
+                        e[c] += w[c] * packet.e_cos[c];
+                    }
+                }
+                e
+            }
+        }
+    }
+
+    /// W_o at a point with shading normal `n` seen from `wo`, per channel.
+    pub fn leaving(&self, n: DVec3, wo: DVec3) -> Rgb {
+        match self {
+            BoundaryWeights::Fresnel { eta, norm } => [ft_dielectric(n.dot(wo), *eta) * norm; 3],
+            BoundaryWeights::Albedo { table, .. } => table.exit_weight(n.dot(wo).abs()),
+        }
+    }
+
+    /// True for Fresnel's weights, the same in every channel.
+    pub fn is_fresnel(&self) -> bool {
+        matches!(self, BoundaryWeights::Fresnel { .. })
+    }
+}
 
 /// A material's model, split by what integrators may do with it.
 pub enum ShadingModel {
@@ -66,6 +140,8 @@ pub struct TranslucentShading {
     pub norm: f64,
     /// The pre-scatter texture.
     pub texture: Option<Texture>,
+    /// The angular factors of the material's radial model.
+    pub weights: BoundaryWeights,
     /// The disk-average quadrature of [`rd_sample_scene`](Self::rd_sample_scene).
     disk: DiskRule,
 }
@@ -89,6 +165,7 @@ impl TranslucentShading {
             eta,
             norm: 1.0 / (fresnel_normalization(eta) * PI),
             texture: t.texture.clone(),
+            weights: BoundaryWeights::of(t),
             disk,
         }
     }
@@ -352,11 +429,35 @@ impl TranslucentShading {
         }
     }
 
-    /// The exit weight F_t(η, n·ω_o)/(cπ) of a radial model at a point with shading normal `n`
-    /// seen from direction `wo`.
+    /// The Fresnel exit weight F_t(η, n·ω_o)/(cπ) of a radial model at a point with shading
+    /// normal `n` seen from direction `wo`: one number for every channel, as the methods that
+    /// bound and cluster by it need (the many-light ones; they refuse
+    /// [`BoundaryWeights::Albedo`], [`Self::scalar_weights`]).
     #[inline]
     pub fn exit_weight(&self, n: DVec3, wo: DVec3) -> f64 {
         ft_dielectric(n.dot(wo), self.eta) * self.norm
+    }
+
+    /// The material's exit weight W_o per channel ([`BoundaryWeights::leaving`]): equal to
+    /// [`Self::exit_weight`] in every channel for Fresnel's weights.
+    #[inline]
+    pub fn exit_weights(&self, n: DVec3, wo: DVec3) -> Rgb {
+        self.weights.leaving(n, wo)
+    }
+
+    /// Ok when the material's weights are Fresnel's (one number per point); otherwise an
+    /// error naming the material and `method`, which needs them so.
+    pub fn scalar_weights(&self, method: &str) -> Result<(), crate::Error> {
+        if self.weights.is_fresnel() {
+            Ok(())
+        } else {
+            Err(crate::Error::Unsupported(format!(
+                "material `{}`: method {method} bounds and clusters with Fresnel's angular \
+                 factors, one number per point; `angular = \"albedo\"` weighs each channel \
+                 (use exact, pathtrace, the trees or separable)",
+                self.name
+            )))
+        }
     }
 
     /// The pre-scatter texture at `p` (1 without a texture).
@@ -563,6 +664,7 @@ mod tests {
                 medium,
                 units_per_mm,
                 texture: None,
+                angular: Default::default(),
             },
         )
     }

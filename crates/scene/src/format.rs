@@ -71,6 +71,7 @@ pub(super) struct MaterialDef {
     pub units_per_mm: Option<f64>,
     pub albedo: Option<Triple>,
     pub texture: Option<TextureDef>,
+    pub angular: Option<String>,
 }
 
 /// A `texture = { type = .., .. }` table (keys depend on `type`).
@@ -154,6 +155,7 @@ impl Keys for MaterialDef {
             ("units_per_mm", self.units_per_mm.is_some()),
             ("albedo", self.albedo.is_some()),
             ("texture", self.texture.is_some()),
+            ("angular", self.angular.is_some()),
         ])
     }
 }

@@ -186,6 +186,31 @@ pub struct Translucent {
     pub units_per_mm: f64,
     /// Optional pre-scatter albedo texture (values in [0, 1]).
     pub texture: Option<Texture>,
+    /// How light enters and leaves the model's profile.
+    pub angular: Angular,
+}
+
+/// The angular factors of a radial model, S = W_i(θ_i) R_d(r) W_o(θ_o).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Angular {
+    /// W_i = F_t(η, cos θ_i), W_o = F_t(η, cos θ_o)/(cπ) (pbrt 3rd ed. §11.4.2): every model's
+    /// own, and the default.
+    #[default]
+    Fresnel,
+    /// The half-space's directional albedo A(θ) from the random walk
+    /// (`sss_bssrdf::DirectionalAlbedo`): W_i = F_t(η, 1) A(θ_i)/A(0°), W_o = A(θ_o)/(πĀ), so
+    /// that oblique light returns what real transport returns and leaves in its lobe.
+    Albedo,
+}
+
+impl Angular {
+    /// The scene file's name for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Angular::Fresnel => "fresnel",
+            Angular::Albedo => "albedo",
+        }
+    }
 }
 
 /// What a material is.

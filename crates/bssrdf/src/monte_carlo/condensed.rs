@@ -263,6 +263,7 @@ pub fn simulate_albedos(cfg: &CondensedConfig) -> Result<CondensedProfile, Bssrd
         albedo: rho_max,
         g: cfg.g,
         eta_out: 1.0 / cfg.eta,
+        analog: false,
         max_events: cfg.max_events,
         inv_dr: bins as f64 / r_max,
         r_max,
@@ -339,7 +340,7 @@ fn run_chunk(
         weights: vec![0.0; rows],
     };
     for _ in 0..photons {
-        let traced = trace_photon(walk, &mut rng, &mut |r, w, events| {
+        let traced = trace_photon(walk, crate::DVec3::NEG_Z, &mut rng, &mut |r, w, events| {
             if events < min_events {
                 return;
             }

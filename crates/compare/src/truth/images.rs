@@ -107,8 +107,12 @@ pub(crate) fn write_plot(path: &Path, case: &str, runs: &[TruthRun]) -> Result<(
             );
         }
     }
-    for (i, model) in ModelKind::ALL.into_iter().enumerate() {
-        let p = points(&|r| r.method == "exact" && r.model == model.name());
+    let names = ModelKind::ALL
+        .iter()
+        .map(|m| m.name())
+        .chain([super::runs::ALBEDO_MODEL]);
+    for (i, model) in names.enumerate() {
+        let p = points(&|r| r.method == "exact" && r.model == model);
         if !p.is_empty() {
             series.push(
                 Series::line(format!("exact, {model}"), p)

@@ -59,7 +59,7 @@ use sss_render::integrators::{self, MethodOptions};
 use sss_render::irradiance::IrradianceSettings;
 use sss_render::progress::NoProgress;
 use sss_render::scene::{
-    self, Light, LoadOptions, MaterialKind, Scene, SceneError, SceneErrorKind,
+    self, Angular, Light, LoadOptions, MaterialKind, Scene, SceneError, SceneErrorKind,
 };
 use sss_render::{RenderOutput, RenderSettings, render};
 use sss_util::luminance;

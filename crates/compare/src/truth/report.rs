@@ -101,11 +101,15 @@ pub(crate) fn section(
     );
     let mut rows = Vec::new();
     for c in results {
-        for model in ModelKind::ALL {
+        let names = ModelKind::ALL
+            .iter()
+            .map(|m| m.name())
+            .chain([runs::ALBEDO_MODEL]);
+        for model in names {
             let find = |method: &str| {
                 c.runs
                     .iter()
-                    .find(|r| r.method == method && r.model == model.name())
+                    .find(|r| r.method == method && r.model == model)
             };
             let (Some(exact), Some(pt)) = (find("exact"), find("pathtrace")) else {
                 continue;
@@ -113,7 +117,7 @@ pub(crate) fn section(
             let floor = pt.floor.unwrap_or(pt.score.rel_rmse);
             rows.push(vec![
                 c.case.clone(),
-                model.name().to_string(),
+                model.to_string(),
                 ratios(pt),
                 md_pct(Some(floor)),
                 if exact.warnings > 0 {

@@ -21,6 +21,9 @@ pub const PATHTRACE_SPP: u32 = 256;
 /// The model the fast methods render with.
 pub const FAST_MODEL: ModelKind = ModelKind::McTable;
 
+/// The name of `mc-table` with `angular = "albedo"` in the runs' `model` column.
+pub const ALBEDO_MODEL: &str = "mc-table+albedo";
+
 /// One run scored against the truth.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct TruthRun {
@@ -119,8 +122,25 @@ pub(crate) fn run_case(
             ..IrradianceSettings::default()
         },
     };
-    for model in ModelKind::ALL {
-        let scene = scene_for(model)?;
+    // Every model, and `mc-table` with the half-space's directional albedo for its angular
+    // factors (`angular = "albedo"`, the model the measured deficit led to): (name, scene).
+    let variant = |k: usize| -> Result<(&'static str, Scene), Error> {
+        match ModelKind::ALL.get(k) {
+            Some(&model) => Ok((model.name(), scene_for(model)?)),
+            None => {
+                let mut scene = scene_for(ModelKind::McTable)?;
+                for m in &mut scene.materials {
+                    if let MaterialKind::Translucent(t) = &mut m.kind {
+                        t.angular = Angular::Albedo;
+                    }
+                }
+                Ok((ALBEDO_MODEL, scene))
+            }
+        }
+    };
+    let variants = ModelKind::ALL.len() + 1;
+    for k in 0..variants {
+        let (model, scene) = variant(k)?;
         let r = render(&scene, &exact, &settings(cfg.seed), &NoProgress)
             .map_err(|e| Error(format!("truth {}: exact with {model}: {e}", case.name())))?;
         (ctx.log)(&format!(
@@ -128,14 +148,14 @@ pub(crate) fn run_case(
             case.name(),
             r.seconds_total()
         ));
-        out.runs.push(row("exact", model.name(), "", 0.0, &r));
-        out.model_images.push((model.name(), r.subsurface));
+        out.runs.push(row("exact", model, "", 0.0, &r));
+        out.model_images.push((model, r.subsurface));
     }
     // Every model under `pathtrace` too: it converges to the integral `exact`'s sum
     // discretises, so where `exact`'s samples are coarse (the capped head) it is the model's
     // image; its own noise is removed from its floor.
-    for model in ModelKind::ALL {
-        let scene = scene_for(model)?;
+    for k in 0..variants {
+        let (model, scene) = variant(k)?;
         let method = PathTrace {
             spp: PATHTRACE_SPP,
             ..PathTrace::default()
@@ -147,7 +167,7 @@ pub(crate) fn run_case(
             ))
         })?;
         let se = r.std_error.clone().unwrap_or_default();
-        let mut run = row("pathtrace", model.name(), "spp", PATHTRACE_SPP as f64, &r);
+        let mut run = row("pathtrace", model, "spp", PATHTRACE_SPP as f64, &r);
         run.floor = Some(score_without_noise(&r.subsurface, &se, truth).rel_rmse);
         out.runs.push(run);
     }

@@ -202,6 +202,14 @@ pub(crate) fn add_scaled(acc: &mut Rgb, v: Rgb, s: f64) {
     }
 }
 
+/// acc += v · w, channel by channel.
+#[inline]
+pub(crate) fn add_weighted(acc: &mut Rgb, v: Rgb, w: Rgb) {
+    for c in 0..3 {
+        acc[c] += v[c] * w[c];
+    }
+}
+
 /// The mean of `k` estimates from their sum and sum of squares, and the variance of that mean
 /// (the unbiased sample variance over k; 0 for k = 1).
 pub(crate) fn mean_and_variance(sum: Rgb, sum2: Rgb, k: u32) -> (Rgb, Rgb) {

@@ -18,7 +18,7 @@ use crate::kernel_choice::{
 use crate::lights::{Receiver, gather};
 use crate::progress::Progress;
 use crate::rng::{Stream, rng};
-use crate::shading::transmitted_irradiance;
+
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
 use sss_scene::Scene;
@@ -191,7 +191,7 @@ impl Integrator for Separable {
                         &mut r,
                         packets,
                     );
-                    transmitted_irradiance(packets, g.n, sh.eta, sh.texture_at(g.p))
+                    sh.weights.entering(packets, g.n, sh.texture_at(g.p))
                 })
                 .collect()
         });
@@ -248,8 +248,8 @@ impl Integrator for Separable {
                         return;
                     }
                     let f = filtered[g.pixel as usize];
-                    let s = sh.exit_weight(g.n, g.wo);
-                    *value = [f[0] as f64 * s, f[1] as f64 * s, f[2] as f64 * s];
+                    let s = sh.exit_weights(g.n, g.wo);
+                    *value = [f[0] as f64 * s[0], f[1] as f64 * s[1], f[2] as f64 * s[2]];
                 });
         }
         progress.advance(gb.samples.len() as u64);

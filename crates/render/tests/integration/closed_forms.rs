@@ -191,6 +191,7 @@ fn slab(units_per_mm: f64) -> ([f64; 3], [f64; 3]) {
             medium: Medium::preset("marble").unwrap(),
             units_per_mm: u,
             texture: None,
+            angular: Default::default(),
         }),
     };
     let e0 = [2.0, 1.0, 0.5];

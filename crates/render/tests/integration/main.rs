@@ -3,6 +3,7 @@
 //! saves most of the suite's link time. Run one file's tests with
 //! `cargo test -p sss-render --test integration <module>::`.
 
+mod angular_albedo;
 mod bounded_resources;
 mod closed_forms;
 mod common;

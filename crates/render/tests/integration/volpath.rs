@@ -20,6 +20,7 @@ fn white(sigma_s: [f64; 3]) -> Material {
             medium: Medium::new([0.0; 3], sigma_s, 0.0, 1.3).unwrap(),
             units_per_mm: 1.0,
             texture: None,
+            angular: Default::default(),
         }),
     }
 }

@@ -3,7 +3,7 @@
 
 use super::context::{Ctx, fmt_num, list};
 use crate::format::{Keys, MaterialDef, Triple};
-use crate::{MaterialKind, SceneError, Translucent};
+use crate::{Angular, MaterialKind, SceneError, Translucent};
 use sss_bssrdf::presets::{PRESET_ETA, PRESETS};
 use sss_bssrdf::{Medium, ModelKind, Rgb};
 use std::str::FromStr;
@@ -27,6 +27,7 @@ impl Ctx<'_> {
                         "eta",
                         "units_per_mm",
                         "texture",
+                        "angular",
                     ],
                     what,
                 )?;
@@ -131,11 +132,32 @@ impl Ctx<'_> {
                     Some(t) => Some(self.texture(t, &key("texture"))?),
                     None => None,
                 };
+                let angular = match m.angular.as_deref() {
+                    None | Some("fresnel") => Angular::Fresnel,
+                    Some("albedo") => Angular::Albedo,
+                    Some(other) => {
+                        return Err(self.err(
+                            &key("angular"),
+                            format!(
+                                "unknown angular factors `{other}`; expected one of fresnel, albedo"
+                            ),
+                        ));
+                    }
+                };
+                if angular == Angular::Albedo && model == ModelKind::DirectionalDipole {
+                    return Err(self.err(
+                        &key("angular"),
+                        "angular = \"albedo\" reshapes a radial model's entry and exit; the \
+                         directional dipole has its own S (choose a radial model or leave \
+                         `angular` out)",
+                    ));
+                }
                 Ok(MaterialKind::Translucent(Translucent {
                     model,
                     medium,
                     units_per_mm: upm,
                     texture,
+                    angular,
                 }))
             }
             "diffuse" => {

@@ -476,6 +476,39 @@ fn sun_lights() {
     );
 }
 
+/// `angular` is `fresnel` by default, `albedo` on request, refused with the directional
+/// dipole (which has its own S) and for any other word.
+#[test]
+fn angular_factors() {
+    let jelly = |s: &sss_scene::Scene| match &s.materials[1].kind {
+        MaterialKind::Translucent(t) => t.angular,
+        _ => panic!("jelly is translucent"),
+    };
+    let s = load_str(GOOD, "good.toml", None, &no_dirs()).unwrap();
+    assert_eq!(jelly(&s), sss_scene::Angular::Fresnel);
+    let text = with("eta = 1.4", "eta = 1.4\nangular = \"albedo\"");
+    let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+    assert_eq!(jelly(&s), sss_scene::Angular::Albedo);
+    let text = with("eta = 1.4", "eta = 1.4\nangular = \"fresnel\"");
+    let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+    assert_eq!(jelly(&s), sss_scene::Angular::Fresnel);
+    assert_err(
+        &with("eta = 1.4", "eta = 1.4\nangular = \"lambert\""),
+        Some("lambert"),
+        Some("materials.jelly.angular"),
+        &["unknown angular factors", "lambert", "fresnel", "albedo"],
+    );
+    assert_err(
+        &with(
+            "model = \"directional-dipole\"",
+            "model = \"directional-dipole\"\nangular = \"albedo\"",
+        ),
+        Some("angular = \"albedo\""),
+        Some("materials.skin.angular"),
+        &["directional dipole", "radial model"],
+    );
+}
+
 #[test]
 fn material_errors() {
     assert_err(

@@ -47,7 +47,7 @@ use sss_render::integrators::pathtrace::PathTrace;
 use sss_render::integrators::volpath::{Scattering, VolPath};
 use sss_render::progress::NoProgress;
 use sss_render::scene::{
-    self, Light, LoadOptions, MaterialKind, Scene, SceneError, SceneErrorKind,
+    self, Angular, Light, LoadOptions, MaterialKind, Scene, SceneError, SceneErrorKind,
 };
 use sss_render::{RenderSettings, render};
 use std::path::PathBuf;
@@ -165,20 +165,44 @@ impl Experiment for DeficitExperiment {
                 plan.target,
                 cfg.seed + 1,
             )?;
+            // The same model with the half-space's directional albedo for its angular factors.
+            let mut weighted = scene.clone();
+            for m in &mut weighted.materials {
+                if let MaterialKind::Translucent(t) = &mut m.kind {
+                    t.angular = Angular::Albedo;
+                }
+            }
+            let model_pt = |spp: u32| -> Box<dyn Integrator> {
+                Box::new(PathTrace {
+                    spp,
+                    ..PathTrace::default()
+                })
+            };
+            let (albedo, _) = measure(
+                &weighted,
+                &model_pt,
+                plan.pathtrace_spp,
+                plan.target,
+                cfg.seed + 1,
+            )?;
             let row = DeficitRow {
                 setup: setup.clone(),
                 truth,
                 single,
                 model,
+                albedo,
                 pixels: pixels.len(),
             };
             let r = row.ratio();
             (ctx.log)(&format!(
-                "deficit [{}/{total}] {name}: {} / truth = {} (volpath {} paths, {:.1} s; \
-                 pathtrace {} samples, {:.1} s)",
+                "deficit [{}/{total}] {name}: {} / truth = {}, with angular = albedo {} \
+                 (volpath {} paths, {:.1} s; pathtrace {} samples, {:.1} s)",
                 i + 1,
                 MODEL.name(),
                 r.map(|v| v.map_or("-".to_string(), |(x, _)| format!("{x:.3}")))
+                    .join(" / "),
+                row.albedo_ratio()
+                    .map(|v| v.map_or("-".to_string(), |(x, _)| format!("{x:.3}")))
                     .join(" / "),
                 truth.spp,
                 truth.seconds,

@@ -17,6 +17,8 @@ pub(crate) struct DeficitRow {
     pub single: Mean,
     /// The model under `pathtrace`.
     pub model: Mean,
+    /// The model with `angular = "albedo"` under `pathtrace`.
+    pub albedo: Mean,
     /// Pixels the means are over.
     pub pixels: usize,
 }
@@ -27,6 +29,11 @@ impl DeficitRow {
         ratio(&self.model, &self.truth)
     }
 
+    /// The model with the directional albedo's angular factors over the truth.
+    pub fn albedo_ratio(&self) -> [Option<(f64, f64)>; 3] {
+        ratio(&self.albedo, &self.truth)
+    }
+
     /// Single scattering's share of the truth, per channel, with its standard error.
     pub fn single_share(&self) -> [Option<(f64, f64)>; 3] {
         ratio(&self.single, &self.truth)
@@ -34,7 +41,7 @@ impl DeficitRow {
 }
 
 /// The columns of `deficit.csv`.
-pub const COLUMNS: [&str; 28] = [
+pub const COLUMNS: [&str; 34] = [
     "group",
     "medium",
     "param",
@@ -55,6 +62,12 @@ pub const COLUMNS: [&str; 28] = [
     "ratio_se_r",
     "ratio_se_g",
     "ratio_se_b",
+    "albedo_ratio_r",
+    "albedo_ratio_g",
+    "albedo_ratio_b",
+    "albedo_ratio_se_r",
+    "albedo_ratio_se_g",
+    "albedo_ratio_se_b",
     "single_r",
     "single_g",
     "single_b",
@@ -83,6 +96,9 @@ pub(crate) fn deficit_csv(rows: &[DeficitRow], _threads: usize) -> Csv {
         f.extend(r.model.mean.iter().map(|&v| csv_num(Some(v))));
         f.extend(q.iter().map(|v| csv_num(v.map(|x| x.0))));
         f.extend(q.iter().map(|v| csv_num(v.map(|x| x.1))));
+        let a = r.albedo_ratio();
+        f.extend(a.iter().map(|v| csv_num(v.map(|x| x.0))));
+        f.extend(a.iter().map(|v| csv_num(v.map(|x| x.1))));
         f.extend(s.iter().map(|v| csv_num(v.map(|x| x.0))));
         f.push(r.truth.spp.to_string());
         f.push(r.model.spp.to_string());
@@ -132,6 +148,9 @@ pub(crate) struct Apportioned {
     pub size: Rgb,
     pub angles: Rgb,
     pub profile: Rgb,
+    /// With `angular = "albedo"`: model / truth at scale 1 and in the flat limit.
+    pub albedo_total: Rgb,
+    pub albedo_flat: Rgb,
 }
 
 /// The flat limit of a ratio measured at scales `s1 < s2`, assuming what is left of the size
@@ -174,6 +193,10 @@ pub(crate) fn apportion(rows: &[DeficitRow]) -> Vec<Apportioned> {
         let q = r.ratio();
         Some([q[0]?.0, q[1]?.0, q[2]?.0])
     };
+    let albedo_of = |r: &DeficitRow| -> Option<Rgb> {
+        let q = r.albedo_ratio();
+        Some([q[0]?.0, q[1]?.0, q[2]?.0])
+    };
     let mut out = Vec::new();
     for (g, m) in keys {
         let Some(head_on) = row_at(rows, "incidence", m, 0.0) else {
@@ -199,8 +222,12 @@ pub(crate) fn apportion(rows: &[DeficitRow]) -> Vec<Apportioned> {
         ) else {
             continue;
         };
+        let (Some(at), Some(a1), Some(a2)) = (albedo_of(unit), albedo_of(r1), albedo_of(r2)) else {
+            continue;
+        };
         let (s1, s2) = (scale_of(r1), scale_of(r2));
         let flat: Rgb = std::array::from_fn(|c| flat_limit((s1, d1[c]), (s2, d2[c])));
+        let albedo_flat: Rgb = std::array::from_fn(|c| flat_limit((s1, a1[c]), (s2, a2[c])));
         let div = |a: Rgb, b: Rgb| -> Rgb {
             std::array::from_fn(|c| if b[c] != 0.0 { a[c] / b[c] } else { 0.0 })
         };
@@ -214,6 +241,8 @@ pub(crate) fn apportion(rows: &[DeficitRow]) -> Vec<Apportioned> {
             size: div(t, flat),
             angles: div(flat, n),
             profile: n,
+            albedo_total: at,
+            albedo_flat,
         });
     }
     out
@@ -317,6 +346,7 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
                 vec![
                     md_num(Some(r.setup.value), 4),
                     rgb3(r.ratio(), true),
+                    rgb3(r.albedo_ratio(), false),
                     rgb3(r.single_share(), false),
                     format!(
                         "{} / {}",
@@ -330,6 +360,7 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
             &[
                 param,
                 "model / truth (R / G / B)",
+                "with angular = albedo",
                 "single (R / G / B)",
                 "s: volpath / pathtrace",
             ],
@@ -398,6 +429,7 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
                     format!("{} ({})", f3(a.size), s3(sh[0])),
                     format!("{} ({})", f3(a.angles), s3(sh[1])),
                     format!("{} ({})", f3(a.profile), s3(sh[2])),
+                    format!("{}; {}", f3(a.albedo_total), f3(a.albedo_flat)),
                 ]
             })
             .collect();
@@ -419,6 +451,7 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
                 "size (curvature, thin parts)",
                 "angles (incidence, exit)",
                 "profile and boundary",
+                "with angular = albedo: scale 1; flat limit",
             ],
             &table,
         ));

@@ -74,6 +74,7 @@ fn row(group: &'static str, kind: Kind, value: f64, model: Rgb, truth: Rgb) -> D
         truth: mean(truth, [0.0; 3]),
         single: mean([0.1; 3], [0.0; 3]),
         model: mean(model, [0.0; 3]),
+        albedo: mean(model, [0.0; 3]),
         pixels: 4,
     }
 }

@@ -45,7 +45,7 @@ use crate::integrators::options::{
 };
 use crate::integrators::{
     Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
-    add_scaled, check_radial,
+    add_scaled, add_weighted, check_radial,
 };
 use crate::irradiance::IrradianceSettings;
 use crate::progress::Progress;
@@ -345,7 +345,7 @@ impl Integrator for DualTree {
                     let gi = obj.sample(k);
                     let g = &frame.gbuffer.samples[gi];
                     let mut v = [0.0; 3];
-                    add_scaled(&mut v, *a, sh.exit_weight(g.n, g.wo));
+                    add_weighted(&mut v, *a, sh.exit_weights(g.n, g.wo));
                     values[gi] = v;
                     let p = g.pixel as usize;
                     let r = obj.ordered[k].rate;

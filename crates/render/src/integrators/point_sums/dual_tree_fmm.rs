@@ -114,7 +114,7 @@ use crate::integrators::options::{
 };
 use crate::integrators::{
     Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep, add_scaled,
-    check_radial,
+    add_weighted, check_radial,
 };
 use crate::irradiance::IrradianceSettings;
 use crate::progress::Progress;
@@ -804,7 +804,7 @@ impl Integrator for DualTreeFmm {
                     // A truncated expansion may dip below 0 where the sum is near 0.
                     let a = a.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
                     let mut v = [0.0; 3];
-                    add_scaled(&mut v, a, sh.exit_weight(g.n, g.wo));
+                    add_weighted(&mut v, a, sh.exit_weights(g.n, g.wo));
                     values[gi] = v;
                 }
             })

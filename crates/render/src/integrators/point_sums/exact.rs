@@ -20,7 +20,7 @@ use crate::gbuffer::GSample;
 use crate::integrators::Converges;
 use crate::integrators::options::SAMPLE_OPTIONS;
 use crate::integrators::options::sample_settings;
-use crate::integrators::{Integrator, Method, MethodOptions, Shaded, Stat, Sweep, add_scaled};
+use crate::integrators::{Integrator, Method, MethodOptions, Shaded, Stat, Sweep, add_weighted};
 use crate::irradiance::{IrradianceSettings, ObjectSamples};
 use crate::progress::Progress;
 use crate::shading::TranslucentShading;
@@ -155,7 +155,7 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
             .map(|s| (s.position, s.area, s.irradiance)),
     );
     let mut out = [0.0; 3];
-    add_scaled(&mut out, sum, shading.exit_weight(g.n, g.wo));
+    add_weighted(&mut out, sum, shading.exit_weights(g.n, g.wo));
     out
 }
 

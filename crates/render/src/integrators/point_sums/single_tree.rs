@@ -25,7 +25,8 @@ use crate::integrators::options::{
     MAX_SAMPLES, SOLID_ANGLE_EPS, SPACING, eps_option, sample_settings,
 };
 use crate::integrators::{
-    Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep, add_scaled, check_radial,
+    Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep, add_scaled, add_weighted,
+    check_radial,
 };
 use crate::irradiance::IrradianceSettings;
 use crate::progress::Progress;
@@ -155,7 +156,7 @@ impl Integrator for SingleTree {
                         (Some(sh), Some(t)) => {
                             let sum = single(t, g.p, self.eps, sh, &counts);
                             let mut out = [0.0; 3];
-                            add_scaled(&mut out, sum, sh.exit_weight(g.n, g.wo));
+                            add_weighted(&mut out, sum, sh.exit_weights(g.n, g.wo));
                             out
                         }
                         _ => [0.0; 3],

@@ -117,6 +117,7 @@ pub(crate) fn object_data(
             continue;
         };
         sh.radial(method)?;
+        sh.scalar_weights(method)?;
         if sh.texture.is_some() {
             return Err(Error::Input(format!(
                 "material `{}`: method {method} does not support pre-scatter textures (the \

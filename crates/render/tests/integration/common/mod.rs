@@ -134,6 +134,7 @@ pub fn translucent(model: ModelKind, preset: &str, units_per_mm: f64) -> Materia
             medium: Medium::preset(preset).unwrap(),
             units_per_mm,
             texture: None,
+            angular: Default::default(),
         }),
     }
 }
