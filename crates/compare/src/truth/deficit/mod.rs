@@ -1,11 +1,12 @@
 //! `cargo xtask compare --deficit`: where a BSSRDF model's error against real light transport
 //! comes from, measured on controlled set-ups.
 //!
-//! Every row renders one set-up ([`setups`]) three times and takes image means over the
+//! Every row renders one set-up ([`setups`]) four times and takes image means over the
 //! scored pixels ([`measure`]): `volpath` (the truth: light transport in the medium itself,
 //! checked against Mitsuba 3 and MCML), `volpath --scattering single` (the truth's single
-//! scattering alone) and `mc-table` under `pathtrace` (the model's integral, which discretises
-//! nothing). Each is rendered until the relative standard error of its mean is about the
+//! scattering alone), `mc-table` under `pathtrace` (the model's integral, which discretises
+//! nothing) and the same with `angular = "albedo"` (the half-space's directional albedo for
+//! its angular factors, `sss_bssrdf::DirectionalAlbedo`). Each is rendered until the relative standard error of its mean is about the
 //! target. The model over the truth, per channel, is the row's figure; the sweeps separate
 //! the effects the planar, normal-incidence, separable model leaves out:
 //!
