@@ -18,7 +18,6 @@ use crate::kernel_choice::{
 use crate::lights::{Receiver, gather};
 use crate::progress::Progress;
 use crate::rng::{Stream, rng};
-
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
 use sss_scene::Scene;
