@@ -125,6 +125,16 @@ impl Case {
     }
 }
 
+/// Gives every translucent material of `scene` the half-space's directional albedo for its
+/// angular factors (`angular = "albedo"`).
+pub(crate) fn with_albedo_weights(scene: &mut Scene) {
+    for m in &mut scene.materials {
+        if let MaterialKind::Translucent(t) = &mut m.kind {
+            t.angular = Angular::Albedo;
+        }
+    }
+}
+
 /// What one run of the experiment does.
 #[derive(Clone, Debug)]
 pub(crate) struct Plan {

@@ -129,11 +129,7 @@ pub(crate) fn run_case(
             Some(&model) => Ok((model.name(), scene_for(model)?)),
             None => {
                 let mut scene = scene_for(ModelKind::McTable)?;
-                for m in &mut scene.materials {
-                    if let MaterialKind::Translucent(t) = &mut m.kind {
-                        t.angular = Angular::Albedo;
-                    }
-                }
+                with_albedo_weights(&mut scene);
                 Ok((ALBEDO_MODEL, scene))
             }
         }

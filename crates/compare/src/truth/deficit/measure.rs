@@ -94,20 +94,9 @@ pub(crate) fn measure(
         let (m, s) = mean_over(&out.subsurface, &se, &pixels);
         Ok((m, s, pixels, seconds))
     };
-    let (m, s, pixels, seconds) = run(pilot)?;
-    let spp = samples_for(pilot, relative_se(m, s), target, most);
-    if spp == pilot {
-        return Ok((
-            Mean {
-                mean: m,
-                se: s,
-                spp,
-                seconds,
-            },
-            pixels,
-        ));
-    }
-    let (m, s, pixels, seconds) = run(spp)?;
+    let pilot_run = run(pilot)?;
+    let spp = samples_for(pilot, relative_se(pilot_run.0, pilot_run.1), target, most);
+    let (m, s, pixels, seconds) = if spp == pilot { pilot_run } else { run(spp)? };
     Ok((
         Mean {
             mean: m,

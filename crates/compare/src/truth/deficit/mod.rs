@@ -37,6 +37,7 @@ mod setups;
 #[cfg(test)]
 mod tests;
 
+use super::plan::with_albedo_weights;
 use super::reference::interior;
 use super::{Context, Error, Experiment, Section};
 use measure::{Mean, measure};
@@ -47,9 +48,7 @@ use sss_render::integrators::Integrator;
 use sss_render::integrators::pathtrace::PathTrace;
 use sss_render::integrators::volpath::{Scattering, VolPath};
 use sss_render::progress::NoProgress;
-use sss_render::scene::{
-    self, Angular, Light, LoadOptions, MaterialKind, Scene, SceneError, SceneErrorKind,
-};
+use sss_render::scene::{self, LoadOptions, MaterialKind, Scene, SceneError, SceneErrorKind};
 use sss_render::{RenderSettings, render};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -150,7 +149,7 @@ impl Experiment for DeficitExperiment {
             };
             let all = volpath(Scattering::All);
             let single = volpath(Scattering::Single);
-            let model = |spp: u32| -> Box<dyn Integrator> {
+            let pathtrace = |spp: u32| -> Box<dyn Integrator> {
                 Box::new(PathTrace {
                     spp,
                     ..PathTrace::default()
@@ -161,27 +160,17 @@ impl Experiment for DeficitExperiment {
                 measure(&scene, &single, plan.volpath_spp, plan.target, cfg.seed + 2)?;
             let (model, pixels) = measure(
                 &scene,
-                &model,
+                &pathtrace,
                 plan.pathtrace_spp,
                 plan.target,
                 cfg.seed + 1,
             )?;
             // The same model with the half-space's directional albedo for its angular factors.
             let mut weighted = scene.clone();
-            for m in &mut weighted.materials {
-                if let MaterialKind::Translucent(t) = &mut m.kind {
-                    t.angular = Angular::Albedo;
-                }
-            }
-            let model_pt = |spp: u32| -> Box<dyn Integrator> {
-                Box::new(PathTrace {
-                    spp,
-                    ..PathTrace::default()
-                })
-            };
+            with_albedo_weights(&mut weighted);
             let (albedo, _) = measure(
                 &weighted,
-                &model_pt,
+                &pathtrace,
                 plan.pathtrace_spp,
                 plan.target,
                 cfg.seed + 1,
@@ -194,17 +183,17 @@ impl Experiment for DeficitExperiment {
                 albedo,
                 pixels: pixels.len(),
             };
-            let r = row.ratio();
+            let three = |q: [Option<(f64, f64)>; 3]| {
+                q.map(|v| v.map_or("-".to_string(), |(x, _)| format!("{x:.3}")))
+                    .join(" / ")
+            };
             (ctx.log)(&format!(
                 "deficit [{}/{total}] {name}: {} / truth = {}, with angular = albedo {} \
                  (volpath {} paths, {:.1} s; pathtrace {} samples, {:.1} s)",
                 i + 1,
                 MODEL.name(),
-                r.map(|v| v.map_or("-".to_string(), |(x, _)| format!("{x:.3}")))
-                    .join(" / "),
-                row.albedo_ratio()
-                    .map(|v| v.map_or("-".to_string(), |(x, _)| format!("{x:.3}")))
-                    .join(" / "),
+                three(row.ratio()),
+                three(row.albedo_ratio()),
                 truth.spp,
                 truth.seconds,
                 model.spp,
@@ -212,7 +201,7 @@ impl Experiment for DeficitExperiment {
             ));
             rows.push(row);
         }
-        deficit_csv(&rows, rayon::current_num_threads()).write(&cfg.out.join("deficit.csv"))?;
+        deficit_csv(&rows).write(&cfg.out.join("deficit.csv"))?;
         write_plots(&cfg.out, &rows)?;
         Ok(section(&rows, &skipped, &plan))
     }

@@ -79,7 +79,7 @@ pub const COLUMNS: [&str; 34] = [
 ];
 
 /// `deficit.csv`: one row per set-up.
-pub(crate) fn deficit_csv(rows: &[DeficitRow], _threads: usize) -> Csv {
+pub(crate) fn deficit_csv(rows: &[DeficitRow]) -> Csv {
     let mut csv = Csv::new(COLUMNS);
     for r in rows {
         let q = r.ratio();
@@ -178,27 +178,15 @@ fn row_at<'a>(
 /// The apportioned deficit of each scaled scene and medium that has its scale-1 row, two
 /// larger ones and the half-space head-on row (`incidence` at 0°) of its medium.
 pub(crate) fn apportion(rows: &[DeficitRow]) -> Vec<Apportioned> {
-    let mut keys: Vec<(&'static str, &'static str)> = Vec::new();
-    for r in rows {
-        let k = (r.setup.group, r.setup.medium.name);
-        if matches!(r.setup.kind, Kind::Scaled { .. }) && !keys.contains(&k) {
-            keys.push(k);
-        }
-    }
+    // Rows that are not scaled have scale 0: a group without a scale-1 row is skipped.
     let scale_of = |r: &DeficitRow| match r.setup.kind {
         Kind::Scaled { scale, .. } => scale,
         _ => 0.0,
     };
-    let ratio_of = |r: &DeficitRow| -> Option<Rgb> {
-        let q = r.ratio();
-        Some([q[0]?.0, q[1]?.0, q[2]?.0])
-    };
-    let albedo_of = |r: &DeficitRow| -> Option<Rgb> {
-        let q = r.albedo_ratio();
-        Some([q[0]?.0, q[1]?.0, q[2]?.0])
-    };
+    let ratio_of = |r: &DeficitRow| values(r.ratio());
+    let albedo_of = |r: &DeficitRow| values(r.albedo_ratio());
     let mut out = Vec::new();
-    for (g, m) in keys {
+    for (g, m) in groups_of(rows) {
         let Some(head_on) = row_at(rows, "incidence", m, 0.0) else {
             continue;
         };
@@ -280,43 +268,52 @@ pub(crate) fn flux_ratio(sweep: &[&DeficitRow], head_on: Option<&DeficitRow>) ->
     if pts.len() < 2 {
         return None;
     }
+    // ∫ L cos θ sin θ dθ of one channel's radiances by the trapezoid rule, the integrand 0
+    // at 90°.
+    let integral = |value: &dyn Fn(&(f64, Rgb, Rgb)) -> f64| -> f64 {
+        let mut nodes: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|p| {
+                let t = p.0.to_radians();
+                (t, value(p) * t.cos() * t.sin())
+            })
+            .collect();
+        nodes.push((std::f64::consts::FRAC_PI_2, 0.0));
+        nodes
+            .windows(2)
+            .map(|w| 0.5 * (w[1].0 - w[0].0) * (w[0].1 + w[1].1))
+            .sum()
+    };
     let mut out = [0.0; 3];
     for (c, o) in out.iter_mut().enumerate() {
-        let f = |p: &(f64, Rgb, Rgb), model: bool| {
-            let t = p.0.to_radians();
-            (if model { p.2[c] } else { p.1[c] }) * t.cos() * t.sin()
-        };
-        let (mut m, mut t) = (0.0, 0.0);
-        for k in 0..pts.len() {
-            let (a, b) = (
-                pts[k].0.to_radians(),
-                pts.get(k + 1).map_or(90.0, |p| p.0).to_radians(),
-            );
-            let (fm, ft) = (f(&pts[k], true), f(&pts[k], false));
-            let (gm, gt) = pts
-                .get(k + 1)
-                .map_or((0.0, 0.0), |p| (f(p, true), f(p, false)));
-            m += 0.5 * (b - a) * (fm + gm);
-            t += 0.5 * (b - a) * (ft + gt);
-        }
+        let t = integral(&|p| p.1[c]);
         if !(t > 0.0) {
             return None;
         }
-        *o = m / t;
+        *o = integral(&|p| p.2[c]) / t;
     }
     Some(out)
 }
 
-/// The (group, medium) pairs of `rows`, in order of first appearance.
-fn groups_of(rows: &[DeficitRow]) -> Vec<(&'static str, &'static str)> {
+/// The distinct items of `items`, in order of first appearance.
+fn unique<T: PartialEq>(items: impl IntoIterator<Item = T>) -> Vec<T> {
     let mut out = Vec::new();
-    for r in rows {
-        let k = (r.setup.group, r.setup.medium.name);
-        if !out.contains(&k) {
-            out.push(k);
+    for x in items {
+        if !out.contains(&x) {
+            out.push(x);
         }
     }
     out
+}
+
+/// The (group, medium) pairs of `rows`, in order of first appearance.
+fn groups_of(rows: &[DeficitRow]) -> Vec<(&'static str, &'static str)> {
+    unique(rows.iter().map(|r| (r.setup.group, r.setup.medium.name)))
+}
+
+/// The three channels' values of a ratio, None if one is missing.
+fn values(q: [Option<(f64, f64)>; 3]) -> Option<Rgb> {
+    Some([q[0]?.0, q[1]?.0, q[2]?.0])
 }
 
 /// The report's section.
@@ -470,16 +467,7 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
 /// each group with more than one row.
 pub(crate) fn write_plots(out: &Path, rows: &[DeficitRow]) -> Result<(), Error> {
     let colours = [[200, 30, 30], [30, 150, 30], [30, 60, 210]];
-    let groups: Vec<&'static str> =
-        groups_of(rows)
-            .into_iter()
-            .map(|k| k.0)
-            .fold(Vec::new(), |mut v, g| {
-                if !v.contains(&g) {
-                    v.push(g);
-                }
-                v
-            });
+    let groups = unique(rows.iter().map(|r| r.setup.group));
     for g in groups {
         let of: Vec<&DeficitRow> = rows.iter().filter(|r| r.setup.group == g).collect();
         if of.len() < 2 {
@@ -488,12 +476,7 @@ pub(crate) fn write_plots(out: &Path, rows: &[DeficitRow]) -> Result<(), Error> 
         let param = of[0].setup.param;
         let log_x = matches!(param, "radius_mm" | "scale" | "thickness_mm");
         let mut series = Vec::new();
-        let mut media: Vec<&'static str> = Vec::new();
-        for r in &of {
-            if !media.contains(&r.setup.medium.name) {
-                media.push(r.setup.medium.name);
-            }
-        }
+        let media = unique(of.iter().map(|r| r.setup.medium.name));
         for (k, m) in media.into_iter().enumerate() {
             for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
                 let points: Vec<(f64, f64)> = of

@@ -4,7 +4,9 @@
 //! truth experiment's scenes with their objects scaled (the medium kept in millimetres), so
 //! that only the size of the object against the mean free path changes.
 
-use super::super::plan::{BUNNY, DRAGON, KETCHUP, Lighting, MARBLE, MediumSpec, SKIN1, SPHERE10};
+use super::super::plan::{
+    BUNNY, Case, DRAGON, KETCHUP, Lighting, MARBLE, MediumSpec, SKIN1, SPHERE10,
+};
 use super::*;
 
 /// The camera's distance to the flat block's centre, mm.
@@ -98,42 +100,44 @@ impl Setup {
         flat_pixels: u32,
         mesh_dirs: &[PathBuf],
     ) -> Result<Scene, SceneError> {
-        let opts = LoadOptions {
-            mesh_dirs: mesh_dirs.to_vec(),
-        };
         let mut s = match self.kind {
             Kind::Flat { .. } | Kind::Cylinder { .. } => {
+                let opts = LoadOptions {
+                    mesh_dirs: mesh_dirs.to_vec(),
+                };
                 let text = self.text(flat_pixels).unwrap_or_default();
-                scene::load_str(&text, &format!("{}.toml", self.name()), None, &opts)?
+                let mut s = scene::load_str(&text, &format!("{}.toml", self.name()), None, &opts)?;
+                for m in &mut s.materials {
+                    if let MaterialKind::Translucent(t) = &mut m.kind {
+                        t.medium = (self.medium.make)();
+                        t.model = model;
+                    }
+                }
+                s
             }
             Kind::Scaled {
-                scene: name,
+                scene,
                 text,
                 lighting,
                 scale,
             } => {
-                let file = format!("truth-{name}.toml");
-                let mut s = scene::load_str(text, &file, None, &opts)?;
-                s.camera.width = (s.camera.width / shrink.max(1)).max(1);
-                s.camera.height = (s.camera.height / shrink.max(1)).max(1);
+                // The truth experiment's case (medium, model, light, resolution), scaled.
+                let case = Case {
+                    scene,
+                    text,
+                    medium: self.medium,
+                    lighting,
+                };
+                let mut s = case.scene(model, shrink, mesh_dirs)?;
                 for m in &mut s.materials {
                     if let MaterialKind::Translucent(t) = &mut m.kind {
                         t.units_per_mm /= scale;
                     }
                 }
-                if lighting == Lighting::Environment {
-                    s.lights = vec![Light::Environment { radiance: [1.0; 3] }];
-                }
                 s
             }
         };
         s.name = self.name();
-        for m in &mut s.materials {
-            if let MaterialKind::Translucent(t) = &mut m.kind {
-                t.medium = (self.medium.make)();
-                t.model = model;
-            }
-        }
         Ok(s)
     }
 }

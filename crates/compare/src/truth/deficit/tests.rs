@@ -159,7 +159,7 @@ fn the_factors_multiply_to_the_deficit() {
 #[test]
 fn every_csv_column_is_documented() {
     let rows = vec![row("incidence", scaled(1.0), 0.0, [1.0; 3], [1.0; 3])];
-    let csv = deficit_csv(&rows, 1);
+    let csv = deficit_csv(&rows);
     assert_eq!(crate::output::undocumented(&csv), Vec::<String>::new());
 }
 
