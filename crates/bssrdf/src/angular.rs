@@ -169,19 +169,7 @@ impl DirectionalAlbedo {
     pub fn cached(medium: &Medium) -> Arc<Self> {
         type Cache = Mutex<Vec<([u64; 8], Arc<DirectionalAlbedo>)>>;
         static CACHE: OnceLock<Cache> = OnceLock::new();
-        let key = {
-            let (a, s) = (medium.sigma_a(), medium.sigma_s());
-            [
-                a[0].to_bits(),
-                a[1].to_bits(),
-                a[2].to_bits(),
-                s[0].to_bits(),
-                s[1].to_bits(),
-                s[2].to_bits(),
-                medium.g().to_bits(),
-                medium.eta().to_bits(),
-            ]
-        };
+        let key = medium.bits();
         let cache = CACHE.get_or_init(|| Mutex::new(Vec::new()));
         if let Some((_, t)) = cache
             .lock()

@@ -35,6 +35,10 @@
 //!   oblique incidence ([`DirectionalAlbedo`]); with it the angular factors become
 //!   F_t(η, 1) A(θ_i)/A(0°) and A(θ_o)/(πĀ), which a renderer may use instead (the scene
 //!   format's `angular = "albedo"`).
+//! - [`sphere_profile`] reshapes a radial model to a ball of radius R: the same walk in a ball
+//!   ([`monte_carlo::simulate_sphere`], tallied by chord distance, which a sphere's hat-box
+//!   area πr² turns into a radial profile on [0, 2R]) minus the walk in the half-space, added
+//!   to the model's profile ([`SphereProfile`]; the scene format's `sphere_radius`).
 //!
 //! ## Papers implemented
 //! - Jensen, Marschner, Levoy, Hanrahan. *A Practical Model for Subsurface Light Transport.*
@@ -56,6 +60,8 @@
 //! - Chandrasekhar. *Radiative Transfer.* 1960, §V — the H function and the plane albedo
 //!   1 − H(μ₀)√(1 − ω) of an isotropic, index-matched half-space, the closed form
 //!   [`angular`]'s walk is tested against.
+//! - Archimedes' hat-box theorem: the area of a sphere's cap within chord distance r of its
+//!   pole is πr², whatever the radius ([`sphere_profile`]).
 
 #![forbid(unsafe_code)]
 
@@ -75,6 +81,7 @@ pub mod presets;
 pub mod profile_table;
 pub mod quadrature;
 pub mod radial;
+pub mod sphere_profile;
 pub mod spline_row;
 pub mod standard_dipole;
 
@@ -91,6 +98,7 @@ pub use inversion::from_reflectance;
 pub use mc_table::McTableModel;
 pub use medium::Medium;
 pub use photon_beam_diffusion::PhotonBeamDiffusion;
+pub use sphere_profile::{SphereDelta, SphereProfile};
 pub use standard_dipole::StandardDipole;
 
 /// Three linear colour channels (red, green, blue): `sss-util`'s, the one colour type of the

@@ -129,6 +129,22 @@ impl Medium {
     pub fn eta(&self) -> f64 {
         self.eta
     }
+    /// The bit patterns of σ_a, σ_s, g and η: equal exactly when the media are, for keying
+    /// caches of per-medium work.
+    pub fn bits(&self) -> [u64; 8] {
+        let (a, s) = (self.sigma_a, self.sigma_s);
+        [
+            a[0].to_bits(),
+            a[1].to_bits(),
+            a[2].to_bits(),
+            s[0].to_bits(),
+            s[1].to_bits(),
+            s[2].to_bits(),
+            self.g.to_bits(),
+            self.eta.to_bits(),
+        ]
+    }
+
     /// Extinction σ_t = σ_a + σ_s of channel `ch` (1/mm).
     pub fn sigma_t(&self, ch: usize) -> f64 {
         self.sigma_a[ch] + self.sigma_s[ch]

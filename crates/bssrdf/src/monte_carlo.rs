@@ -283,6 +283,9 @@ struct Walk<'a> {
     bins: usize,
     /// The bin edges when they are not linear ([`BinSpacing::Edges`]).
     edges: Option<&'a [f64]>,
+    /// The medium's shape: `None` the half-space z < 0, `Some(R)` the ball of radius R (mm)
+    /// under the entry point, centred at (0, 0, −R) ([`simulate_sphere`]).
+    sphere: Option<f64>,
 }
 
 impl Walk<'_> {
@@ -455,7 +458,17 @@ fn trace_photon(
         let mut tau = -(1.0 - uniform(rng)).ln();
         loop {
             let s = tau / walk.sigma_t;
-            if d.z > 0.0 {
+            if let Some(radius) = walk.sphere {
+                match sphere_boundary(walk, radius, s, tau, &mut p, &mut d, &mut w, events, escape)
+                {
+                    SphereStep::Inside => {}
+                    SphereStep::Reflected(left) => {
+                        tau = left;
+                        continue;
+                    }
+                    SphereStep::Spent => return None,
+                }
+            } else if d.z > 0.0 {
                 // p.z <= 0 always, so the distance to the boundary is >= 0.
                 let s_b = -p.z / d.z;
                 if s >= s_b {
@@ -501,6 +514,63 @@ fn trace_photon(
         let (cos_phi, sin_phi) = sample_azimuth(rng);
         d = scatter_direction(d, cos_theta, cos_phi, sin_phi);
     }
+}
+
+/// The boundary step of a walk in a ball of radius `radius` centred at (0, 0, −radius): when
+/// the free path `s` (optical depth `tau`) from `p` along `d` reaches the sphere, moves the
+/// photon onto it, lets w(1 − F) escape (tallied at the chord distance |p| from the entry
+/// point, unless the photon has not collided yet: light crossing the ball without a collision
+/// is not diffuse and belongs to no profile) and reflects the rest about the sphere's normal.
+/// The distance to the sphere from inside is the larger root of
+/// |q + s d|² = R² (q = p − centre): s = −q·d + √((q·d)² − (|q|² − R²)).
+#[allow(clippy::too_many_arguments)]
+fn sphere_boundary(
+    walk: &Walk,
+    radius: f64,
+    s: f64,
+    tau: f64,
+    p: &mut DVec3,
+    d: &mut DVec3,
+    w: &mut f64,
+    events: u64,
+    escape: &mut impl FnMut(f64, f64, u64),
+) -> SphereStep {
+    let centre = DVec3::new(0.0, 0.0, -radius);
+    let q = *p - centre;
+    let b = q.dot(*d);
+    let c = q.length_squared() - radius * radius;
+    let s_b = (-b + (b * b - c).max(0.0).sqrt()).max(0.0);
+    if s < s_b {
+        return SphereStep::Inside;
+    }
+    let q = *p + *d * s_b - centre;
+    let len = q.length();
+    let n = if len > 0.0 { q / len } else { DVec3::Z };
+    *p = centre + n * radius;
+    let left = (tau - s_b * walk.sigma_t).max(0.0);
+    let cos = d.dot(n).clamp(0.0, 1.0);
+    let f = fr_dielectric(cos, walk.eta_out);
+    let escaped = *w * (1.0 - f);
+    if escaped > 0.0 && events > 0 {
+        escape(p.length(), escaped, events);
+    }
+    *w *= f;
+    if *w <= 0.0 {
+        return SphereStep::Spent;
+    }
+    let r = *d - n * (2.0 * d.dot(n));
+    *d = r * r.length_squared().sqrt().recip();
+    SphereStep::Reflected(left)
+}
+
+/// What [`sphere_boundary`] did.
+enum SphereStep {
+    /// The collision comes before the sphere: the photon stays inside.
+    Inside,
+    /// It reached the sphere and the reflected weight goes on with this optical depth left.
+    Reflected(f64),
+    /// It reached the sphere and no weight is left.
+    Spent,
 }
 
 fn run_chunk(walk: &Walk, photons: u64, seed: u64) -> Tally {
@@ -559,6 +629,7 @@ pub(crate) fn condensed_escapes(
         r_max: 0.0,
         bins: 1,
         edges: None,
+        sphere: None,
     };
     trace_photon(&walk, start, rng, &mut |_, w, n| escape(n, w));
 }
@@ -577,6 +648,61 @@ pub(crate) fn simulate_impl(
     medium: &Medium,
     cfg: &McConfig,
     max_events: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<McProfile, BssrdfError> {
+    simulate_in(medium, cfg, max_events, None, false, progress)
+}
+
+/// [`simulate`] in a ball of radius `radius` (mm, finite, > 0) instead of the half-space: the
+/// beam enters at the top of the sphere (the origin, heading down its diameter; the ball is
+/// centred at (0, 0, −radius)), the internal Fresnel splitting uses the sphere's normal, and
+/// the escaping weight is tallied by the *chord* distance between entry and exit point, which
+/// on a sphere says everything (the exit point's position up to the rotation about the
+/// diameter). The area of a sphere within chord distance r of a point is exactly πr² (for
+/// r ≤ 2R, Archimedes' hat-box theorem), so the bins' area normalisation — and with it every
+/// radial model's 2πr R_d(r) — applies unchanged: the result is a radial profile over
+/// [0, 2R] whose integral is the ball's total diffuse reflectance. Light that crosses the ball
+/// without a collision is not tallied (nor counted in `total`). With the same seed, chunk for
+/// chunk, the walks share their random numbers with [`simulate`]'s (common random numbers:
+/// a photon that never reaches where the shapes differ walks the same path).
+pub fn simulate_sphere(
+    medium: &Medium,
+    radius: f64,
+    cfg: &McConfig,
+) -> Result<McProfile, BssrdfError> {
+    if !(radius.is_finite() && radius > 0.0) {
+        return Err(BssrdfError::InvalidArgument(format!(
+            "Monte Carlo: the sphere's radius must be finite and > 0, got {radius} mm"
+        )));
+    }
+    simulate_in(
+        medium,
+        cfg,
+        MAX_SCATTERING_EVENTS,
+        Some(radius),
+        false,
+        &|_| {},
+    )
+}
+
+/// [`simulate`] (`sphere` `None`) or [`simulate_sphere`] with analog absorption (a photon
+/// dies at a collision with probability 1 − α instead of losing weight): walks end when the
+/// light is absorbed, not when its weight falls to the roulette's threshold — near albedo 1
+/// thousands of collisions sooner, at more noise per photon.
+pub(crate) fn simulate_analog(
+    medium: &Medium,
+    cfg: &McConfig,
+    sphere: Option<f64>,
+) -> Result<McProfile, BssrdfError> {
+    simulate_in(medium, cfg, MAX_SCATTERING_EVENTS, sphere, true, &|_| {})
+}
+
+fn simulate_in(
+    medium: &Medium,
+    cfg: &McConfig,
+    max_events: u64,
+    sphere: Option<f64>,
+    analog: bool,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<McProfile, BssrdfError> {
     cfg.validate()?;
@@ -600,12 +726,13 @@ pub(crate) fn simulate_impl(
         albedo: medium.albedo(ch).clamp(0.0, 1.0),
         g: medium.g(),
         eta_out: 1.0 / medium.eta(),
-        analog: false,
+        analog,
         max_events,
         inv_dr: 1.0 / dr,
         r_max: cfg.r_max,
         bins,
         edges: given_edges,
+        sphere,
     });
 
     let n_chunks = cfg.photons.div_ceil(CHUNK_PHOTONS);

@@ -20,7 +20,10 @@
 use crate::lights::Incident;
 use glam::DVec3;
 use sss_bssrdf::fresnel::ft_dielectric;
-use sss_bssrdf::{Bssrdf, DirectionalAlbedo, ModelKind, Rgb, fresnel_normalization, make_model};
+use sss_bssrdf::{
+    Bssrdf, DirectionalAlbedo, ModelKind, Rgb, SphereDelta, SphereProfile, fresnel_normalization,
+    make_model,
+};
 use sss_scene::{Angular, Scene, Texture, Translucent};
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -146,10 +149,31 @@ pub struct TranslucentShading {
     disk: DiskRule,
 }
 
+/// The model of a translucent material: its kind for its medium
+/// ([`sss_bssrdf::make_model`]), reshaped to a ball when the material names a
+/// `sphere_radius` ([`SphereProfile`]: the radius converted to mm). The scene loader refuses a
+/// sphere radius on the directional dipole and radii that are not finite and positive, the only
+/// cases [`SphereProfile::new`] refuses; were one to reach here, the half-space's model is kept.
+pub fn material_model(t: &Translucent) -> Box<dyn Bssrdf> {
+    let base = make_model(t.model, &t.medium);
+    match t.sphere_radius {
+        Some(radius) => {
+            let mm = radius / t.units_per_mm;
+            match SphereDelta::cached(&t.medium, mm) {
+                Ok(delta) if t.model != ModelKind::DirectionalDipole => {
+                    Box::new(SphereProfile::with_delta(base, delta))
+                }
+                _ => base,
+            }
+        }
+        None => base,
+    }
+}
+
 impl TranslucentShading {
     /// Builds the model of a translucent material named `name`.
     pub fn new(name: &str, t: &Translucent) -> Self {
-        let bssrdf = make_model(t.model, &t.medium);
+        let bssrdf = material_model(t);
         let eta = t.medium.eta();
         let model = if t.model == ModelKind::DirectionalDipole {
             ShadingModel::Directional(bssrdf)
@@ -665,6 +689,7 @@ mod tests {
                 units_per_mm,
                 texture: None,
                 angular: Default::default(),
+                sphere_radius: None,
             },
         )
     }

@@ -72,6 +72,17 @@ pub(super) struct MaterialDef {
     pub albedo: Option<Triple>,
     pub texture: Option<TextureDef>,
     pub angular: Option<String>,
+    pub sphere_radius: Option<RadiusDef>,
+}
+
+/// `sphere_radius = 12.5` (scene units) or `sphere_radius = "auto"`.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub(super) enum RadiusDef {
+    /// A length in scene units.
+    Value(f64),
+    /// A keyword (only `auto` is accepted).
+    Keyword(String),
 }
 
 /// A `texture = { type = .., .. }` table (keys depend on `type`).
@@ -156,6 +167,7 @@ impl Keys for MaterialDef {
             ("albedo", self.albedo.is_some()),
             ("texture", self.texture.is_some()),
             ("angular", self.angular.is_some()),
+            ("sphere_radius", self.sphere_radius.is_some()),
         ])
     }
 }

@@ -188,6 +188,11 @@ pub struct Translucent {
     pub texture: Option<Texture>,
     /// How light enters and leaves the model's profile.
     pub angular: Angular,
+    /// The radius (scene units) of the ball whose random walk reshapes the model's profile
+    /// (`sss_bssrdf::SphereProfile`), or `None` for the half-space's profile (the default).
+    /// The file gives a length or `"auto"`: 3 V/A of the material's objects (their volume
+    /// over their area, the radius of a ball for a ball).
+    pub sphere_radius: Option<f64>,
 }
 
 /// The angular factors of a radial model, S = W_i(θ_i) R_d(r) W_o(θ_o).
@@ -369,4 +374,23 @@ impl Scene {
             MaterialKind::Diffuse { .. } => None,
         }
     }
+
+    /// 3 V/A over the objects of material `material` (scene units): the radius of a ball for a
+    /// ball, and for another closed shape the radius of the ball with its volume-to-area ratio
+    /// (what `sphere_radius = "auto"` takes). `None` when they enclose no volume (open or
+    /// inside-out meshes) or the material has no objects.
+    pub fn volume_radius(&self, material: usize) -> Option<f64> {
+        volume_radius(&self.objects, material)
+    }
+}
+
+/// [`Scene::volume_radius`] over `objects`.
+pub(crate) fn volume_radius(objects: &[Object], material: usize) -> Option<f64> {
+    let (mut volume, mut area) = (0.0, 0.0);
+    for o in objects.iter().filter(|o| o.material == material) {
+        volume += shapes::signed_volume(&o.mesh.positions, &o.mesh.triangles);
+        area += shapes::area(&o.mesh.positions, &o.mesh.triangles);
+    }
+    let radius = 3.0 * volume / area;
+    (radius.is_finite() && radius > 0.0).then_some(radius)
 }

@@ -512,6 +512,17 @@ pub(super) fn signed_volume(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 
         / 6.0
 }
 
+/// Total area of a triangle mesh, Σ |(b − a) × (c − a)|/2.
+pub(super) fn area(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum()
+}
+
 /// Whether every undirected edge is shared by exactly two triangles (a closed surface).
 pub(super) fn is_closed(triangles: &[[u32; 3]]) -> bool {
     let mut count: HashMap<(u32, u32), u32> = HashMap::with_capacity(triangles.len() * 3 / 2);

@@ -269,6 +269,7 @@ pub fn simulate_albedos(cfg: &CondensedConfig) -> Result<CondensedProfile, Bssrd
         r_max,
         bins,
         edges: Some(&cfg.edges),
+        sphere: None,
     };
 
     let n_chunks = cfg.photons.div_ceil(CHUNK_PHOTONS);

@@ -110,7 +110,7 @@ pub(crate) fn write_plot(path: &Path, case: &str, runs: &[TruthRun]) -> Result<(
     let names = ModelKind::ALL
         .iter()
         .map(|m| m.name())
-        .chain([super::runs::ALBEDO_MODEL]);
+        .chain(super::runs::VARIANTS);
     for (i, model) in names.enumerate() {
         let p = points(&|r| r.method == "exact" && r.model == model);
         if !p.is_empty() {

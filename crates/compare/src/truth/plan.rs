@@ -135,6 +135,18 @@ pub(crate) fn with_albedo_weights(scene: &mut Scene) {
     }
 }
 
+/// Gives every translucent material of `scene` the profile of the ball of its objects'
+/// volume-to-area ratio (`sphere_radius = "auto"`); materials whose objects enclose no volume
+/// keep the half-space's.
+pub(crate) fn with_ball_profile(scene: &mut Scene) {
+    for m in 0..scene.materials.len() {
+        let radius = scene.volume_radius(m);
+        if let MaterialKind::Translucent(t) = &mut scene.materials[m].kind {
+            t.sphere_radius = radius;
+        }
+    }
+}
+
 /// What one run of the experiment does.
 #[derive(Clone, Debug)]
 pub(crate) struct Plan {

@@ -104,7 +104,7 @@ pub(crate) fn section(
         let names = ModelKind::ALL
             .iter()
             .map(|m| m.name())
-            .chain([runs::ALBEDO_MODEL]);
+            .chain(runs::VARIANTS);
         for model in names {
             let find = |method: &str| {
                 c.runs

@@ -24,6 +24,13 @@ pub const FAST_MODEL: ModelKind = ModelKind::McTable;
 /// The name of `mc-table` with `angular = "albedo"` in the runs' `model` column.
 pub const ALBEDO_MODEL: &str = "mc-table+albedo";
 
+/// The name of `mc-table` with `angular = "albedo"` and `sphere_radius = "auto"` (the profile
+/// of a ball of the object's volume-to-area ratio) in the runs' `model` column.
+pub const BALL_MODEL: &str = "mc-table+albedo+ball";
+
+/// The models beyond [`ModelKind::ALL`] the experiment scores, in report order.
+pub const VARIANTS: [&str; 2] = [ALBEDO_MODEL, BALL_MODEL];
+
 /// One run scored against the truth.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct TruthRun {
@@ -123,18 +130,24 @@ pub(crate) fn run_case(
         },
     };
     // Every model, and `mc-table` with the half-space's directional albedo for its angular
-    // factors (`angular = "albedo"`, the model the measured deficit led to): (name, scene).
+    // factors (`angular = "albedo"`, the model the measured deficit led to), then also with the
+    // profile of the ball of the object's volume-to-area ratio (`sphere_radius = "auto"`):
+    // (name, scene).
     let variant = |k: usize| -> Result<(&'static str, Scene), Error> {
         match ModelKind::ALL.get(k) {
             Some(&model) => Ok((model.name(), scene_for(model)?)),
             None => {
                 let mut scene = scene_for(ModelKind::McTable)?;
                 with_albedo_weights(&mut scene);
-                Ok((ALBEDO_MODEL, scene))
+                let name = VARIANTS[k - ModelKind::ALL.len()];
+                if name == BALL_MODEL {
+                    with_ball_profile(&mut scene);
+                }
+                Ok((name, scene))
             }
         }
     };
-    let variants = ModelKind::ALL.len() + 1;
+    let variants = ModelKind::ALL.len() + VARIANTS.len();
     for k in 0..variants {
         let (model, scene) = variant(k)?;
         let r = render(&scene, &exact, &settings(cfg.seed), &NoProgress)

@@ -192,6 +192,7 @@ fn slab(units_per_mm: f64) -> ([f64; 3], [f64; 3]) {
             units_per_mm: u,
             texture: None,
             angular: Default::default(),
+            sphere_radius: None,
         }),
     };
     let e0 = [2.0, 1.0, 0.5];

@@ -22,6 +22,7 @@ mod render;
 mod scene_framing;
 mod separable_fast_path;
 mod sparse_manylight;
+mod sphere_profile;
 mod subset_reference;
 mod trees;
 mod volpath;

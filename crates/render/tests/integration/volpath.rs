@@ -21,6 +21,7 @@ fn white(sigma_s: [f64; 3]) -> Material {
             units_per_mm: 1.0,
             texture: None,
             angular: Default::default(),
+            sphere_radius: None,
         }),
     }
 }

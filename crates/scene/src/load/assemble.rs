@@ -68,6 +68,14 @@ impl Ctx<'_> {
                 curvature,
             });
         }
+        // `sphere_radius = "auto"` is held as +∞ until the objects are known.
+        for (index, material) in materials.iter_mut().enumerate() {
+            if let MaterialKind::Translucent(t) = &mut material.kind
+                && t.sphere_radius == Some(f64::INFINITY)
+            {
+                t.sphere_radius = Some(self.auto_sphere_radius(&objects, index, &material.name)?);
+            }
+        }
         for (mname, _) in &all_materials {
             if !used.contains_key(mname.as_str()) {
                 self.warnings.push(format!(
@@ -84,6 +92,23 @@ impl Ctx<'_> {
             materials,
             objects,
             warnings: self.warnings,
+        })
+    }
+
+    /// `sphere_radius = "auto"`: [`crate::Scene::volume_radius`] of material `index`, or an
+    /// error when its objects enclose no volume.
+    fn auto_sphere_radius(
+        &self,
+        objects: &[Object],
+        index: usize,
+        name: &str,
+    ) -> Result<f64, SceneError> {
+        crate::volume_radius(objects, index).ok_or_else(|| {
+            self.err(
+                &format!("materials.{name}.sphere_radius"),
+                "\"auto\" takes 3 × volume / area of the material's objects, and they enclose \
+                 no volume (open or inside-out meshes): give a length instead",
+            )
         })
     }
 }

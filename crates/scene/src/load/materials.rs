@@ -2,7 +2,7 @@
 //! coefficients) and diffuse ones.
 
 use super::context::{Ctx, fmt_num, list};
-use crate::format::{Keys, MaterialDef, Triple};
+use crate::format::{Keys, MaterialDef, RadiusDef, Triple};
 use crate::{Angular, MaterialKind, SceneError, Translucent};
 use sss_bssrdf::presets::{PRESET_ETA, PRESETS};
 use sss_bssrdf::{Medium, ModelKind, Rgb};
@@ -28,6 +28,7 @@ impl Ctx<'_> {
                         "units_per_mm",
                         "texture",
                         "angular",
+                        "sphere_radius",
                     ],
                     what,
                 )?;
@@ -152,12 +153,46 @@ impl Ctx<'_> {
                          `angular` out)",
                     ));
                 }
+                let sphere_radius = match &m.sphere_radius {
+                    None => None,
+                    Some(_) if model == ModelKind::DirectionalDipole => {
+                        return Err(self.err(
+                            &key("sphere_radius"),
+                            "sphere_radius reshapes a radial profile; the directional dipole's \
+                             S is not radial (choose a radial model or leave `sphere_radius` out)",
+                        ));
+                    }
+                    // Resolved from the material's objects once they are loaded.
+                    Some(RadiusDef::Keyword(k)) if k == "auto" => Some(f64::INFINITY),
+                    Some(RadiusDef::Keyword(k)) => {
+                        return Err(self.err(
+                            &key("sphere_radius"),
+                            format!(
+                                "unknown sphere radius `{k}`; expected a length in scene units \
+                                 or \"auto\""
+                            ),
+                        ));
+                    }
+                    Some(RadiusDef::Value(r)) => {
+                        if !(r.is_finite() && *r > 0.0) {
+                            return Err(self.err(
+                                &key("sphere_radius"),
+                                format!(
+                                    "the sphere's radius must be finite and > 0 scene units, got {}",
+                                    fmt_num(*r)
+                                ),
+                            ));
+                        }
+                        Some(*r)
+                    }
+                };
                 Ok(MaterialKind::Translucent(Translucent {
                     model,
                     medium,
                     units_per_mm: upm,
                     texture,
                     angular,
+                    sphere_radius,
                 }))
             }
             "diffuse" => {

@@ -509,6 +509,68 @@ fn angular_factors() {
     );
 }
 
+/// `sphere_radius`: a length in scene units, or `"auto"`, 3 V/A of the material's objects (a
+/// torus' is 3/2 of its tube radius: V = 2π²Rr², A = 4π²Rr); refused on the directional
+/// dipole, for non-positive lengths, unknown words, and for objects that enclose no volume.
+#[test]
+fn sphere_radius() {
+    let jelly = |s: &sss_scene::Scene| match &s.materials[1].kind {
+        MaterialKind::Translucent(t) => t.sphere_radius,
+        _ => panic!("jelly is translucent"),
+    };
+    let s = load_str(GOOD, "good.toml", None, &no_dirs()).unwrap();
+    assert_eq!(jelly(&s), None);
+    let text = with("eta = 1.4", "eta = 1.4\nsphere_radius = 2.5");
+    let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+    assert_eq!(jelly(&s), Some(2.5));
+    let text = with("eta = 1.4", "eta = 1.4\nsphere_radius = 3");
+    let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+    assert_eq!(jelly(&s), Some(3.0));
+    // The torus of tube radius 0.25, scaled by 0.5; its tessellation is a little inside.
+    let text = with("eta = 1.4", "eta = 1.4\nsphere_radius = \"auto\"");
+    let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+    let r = jelly(&s).unwrap();
+    assert!((r / 0.1875 - 1.0).abs() < 0.02, "auto radius {r}");
+    for bad in ["0.0", "-1.0", "nan", "inf"] {
+        assert_err(
+            &with("eta = 1.4", &format!("eta = 1.4\nsphere_radius = {bad}")),
+            Some("sphere_radius"),
+            Some("materials.jelly.sphere_radius"),
+            &["finite and > 0"],
+        );
+    }
+    assert_err(
+        &with("eta = 1.4", "eta = 1.4\nsphere_radius = \"big\""),
+        Some("sphere_radius"),
+        Some("materials.jelly.sphere_radius"),
+        &["unknown sphere radius", "big", "auto"],
+    );
+    assert_err(
+        &with(
+            "model = \"directional-dipole\"",
+            "model = \"directional-dipole\"\nsphere_radius = 1.0",
+        ),
+        Some("sphere_radius = 1.0"),
+        Some("materials.skin.sphere_radius"),
+        &["directional dipole", "radial"],
+    );
+    // Jelly on the open floor plane only: no volume.
+    let text = with("eta = 1.4", "eta = 1.4\nsphere_radius = \"auto\"")
+        .replacen("material = \"jelly\"", "material = \"floor\"", 1)
+        .replacen(
+            "material = \"floor\"\nshape = \"plane\"",
+            "material = \"jelly\"\nshape = \"plane\"",
+            1,
+        );
+    let e = load_err(&text);
+    assert_eq!(
+        e.key.as_deref(),
+        Some("materials.jelly.sphere_radius"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("enclose no volume"), "{e}");
+}
+
 #[test]
 fn material_errors() {
     assert_err(

@@ -23,8 +23,8 @@ use crate::progress::Progress;
 use crate::vpls::{bounce_vpls, scene_vpls};
 use glam::DVec3;
 use rayon::prelude::*;
+use sss_bssrdf::Rgb;
 use sss_bssrdf::fresnel::ft_dielectric;
-use sss_bssrdf::{Rgb, make_model};
 use sss_manylight::{
     Estimator, LightTree, RadialProfile, Refinements, Selection, Settings, ShadingPoint,
     ShadingTree, StudentT, Summary, Transmittance, TriangleClusterTree, pixel_seed,
@@ -137,7 +137,8 @@ pub(crate) fn object_data(
                 .map_err(|e| model_error(scene, o, method, e))?;
         // R_d in scene units as `rd_scene` computes it: R_d(r/u)/u², u = units per mm. The
         // profile must own its model, so the material's model is built again here.
-        let model: std::sync::Arc<dyn sss_bssrdf::Bssrdf> = make_model(t.model, &t.medium).into();
+        let model: std::sync::Arc<dyn sss_bssrdf::Bssrdf> =
+            crate::shading::material_model(t).into();
         let u = sh.units_per_mm;
         let inv_u2 = 1.0 / (u * u);
         let diag = frame

@@ -135,6 +135,7 @@ pub fn translucent(model: ModelKind, preset: &str, units_per_mm: f64) -> Materia
             units_per_mm,
             texture: None,
             angular: Default::default(),
+            sphere_radius: None,
         }),
     }
 }
