@@ -16,13 +16,20 @@ fn sphere(extra: &str) -> Scene {
 
 /// [`sphere`] at `n` × `n` pixels.
 fn sphere_at(extra: &str, n: u32) -> Scene {
+    sphere_scaled(extra, n, 1.0)
+}
+
+/// [`sphere_at`] in scene units of 1/`u` mm: every length times `u`, `units_per_mm = u`.
+fn sphere_scaled(extra: &str, n: u32, u: f64) -> Scene {
     let text = format!(
-        "[camera]\nposition = [0.0, 0.0, 40.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 16.0\n\
+        "[camera]\nposition = [0.0, 0.0, {:?}]\ntarget = [0.0, 0.0, 0.0]\nfov = 16.0\n\
          resolution = [{n}, {n}]\n\n[[lights]]\ntype = \"environment\"\nradiance = 1.0\n\n\
          [materials.skin]\ntype = \"translucent\"\nmodel = \"mc-table\"\npreset = \"skin1\"\n\
-         units_per_mm = 1.0\n{extra}\n\n\
-         [[objects]]\nname = \"ball\"\nmaterial = \"skin\"\nshape = \"sphere\"\nradius = 5.0\n\
-         subdivisions = 4\n"
+         units_per_mm = {u:?}\n{extra}\n\n\
+         [[objects]]\nname = \"ball\"\nmaterial = \"skin\"\nshape = \"sphere\"\nradius = {:?}\n\
+         subdivisions = 4\n",
+        40.0 * u,
+        5.0 * u
     );
     load_str(&text, "sphere.toml", None, &Default::default()).unwrap()
 }
@@ -117,6 +124,32 @@ fn every_method_takes_the_ball_profile() {
             let r = m[c] / reference[c];
             eprintln!("{method}, channel {c}: {r:.4} of the reference");
             assert!((r - 1.0).abs() < 0.03, "{method}, channel {c}: {r:.4}");
+        }
+    }
+}
+
+/// `sphere_radius` is in scene units: the same 5 mm ball drawn at 4 units per mm, its radius
+/// given as 20 units (or found by `"auto"`), renders the image of 1 unit per mm within 0.5 %
+/// per channel (`exact`, deterministic; a radius read as millimetres, or multiplied by the
+/// units per millimetre, fails it: a ball of 20 or 80 mm is much darker in red).
+#[test]
+fn the_sphere_radius_is_in_scene_units() {
+    let (mm, _) = mean(
+        &sphere_at("sphere_radius = 5.0", 16),
+        "exact",
+        MethodOptions::new(),
+        1,
+    );
+    for keys in ["sphere_radius = 20.0", "sphere_radius = \"auto\""] {
+        let (scaled, _) = mean(
+            &sphere_scaled(keys, 16, 4.0),
+            "exact",
+            MethodOptions::new(),
+            1,
+        );
+        for c in 0..3 {
+            let r = scaled[c] / mm[c];
+            assert!((r - 1.0).abs() < 5e-3, "{keys}, channel {c}: {r:.5}");
         }
     }
 }
