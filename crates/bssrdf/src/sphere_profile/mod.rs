@@ -232,7 +232,9 @@ impl SphereProfile {
     pub fn with_delta(base: Box<dyn Bssrdf>, delta: Arc<SphereDelta>) -> SphereProfile {
         let r_max = 2.0 * delta.radius;
         let tables = std::array::from_fn(|ch| {
-            let scale = base.medium().reduced_mean_free_path(ch);
+            // The table's grid ends at max(r_max, 10 scales): a scale of at most a tenth of
+            // the diameter ends it at the diameter, so no sample lands beyond it.
+            let scale = base.medium().reduced_mean_free_path(ch).min(0.1 * r_max);
             RadialTable::new(|r| reshaped(base.as_ref(), &delta, ch, r), scale, r_max)
         });
         SphereProfile {

@@ -139,6 +139,17 @@ fn a_huge_ball_is_the_half_space() {
                 "channel {ch}, r {r}: {x} vs {y}"
             );
         }
+        // The bins start at a tenth of a reduced mean free path (the first centre at half of
+        // it) and grow to the diameter.
+        let bins = ball.delta_se(ch);
+        assert_eq!(bins.len(), BINS);
+        let first = 0.05 * skin1().reduced_mean_free_path(ch);
+        assert!(
+            (bins[0].0 / first - 1.0).abs() < 1e-9,
+            "{} vs {first}",
+            bins[0].0
+        );
+        assert!(bins.windows(2).all(|w| w[0].0 < w[1].0) && bins[BINS - 1].0 < 1.0e4);
     }
 }
 
@@ -182,12 +193,53 @@ fn a_small_ball_returns_more_light_and_ends_at_its_diameter() {
             (pdf - 1.0).abs() < 5e-3,
             "channel {ch}: pdf integrates to {pdf}"
         );
-        for k in 0..200 {
-            let r = ball.sample_sr(ch, (k as f64 + 0.5) / 200.0);
+        // Stratified samples: within the diameter, with the mean radius of 2πr R_d^S / total
+        // (by quadrature) within 2 %.
+        let mut mean = 0.0;
+        for k in 0..2000 {
+            let r = ball.sample_sr(ch, (k as f64 + 0.5) / 2000.0);
             assert!(r.is_finite() && (0.0..=2.0 * radius).contains(&r), "{r}");
+            mean += r / 2000.0;
         }
+        let mean_quad: f64 = edges
+            .windows(2)
+            .map(|e| integrate(&|r| r * two_pi_r(r), e[0], e[1], 8))
+            .sum::<f64>()
+            / quad;
+        assert!(
+            (mean / mean_quad - 1.0).abs() < 0.02,
+            "channel {ch}: {mean} vs {mean_quad}"
+        );
+        // The radius holding 90 % of the energy holds it by quadrature.
         let r90 = ball.radius_for_energy(ch, 0.9);
         assert!(r90 > 0.0 && r90 <= 2.0 * radius, "{r90}");
+        let inside: f64 = edges
+            .windows(2)
+            .map(|e| integrate(&two_pi_r, e[0].min(r90), e[1].min(r90), 8))
+            .sum();
+        assert!(
+            (inside / quad - 0.9).abs() < 0.01,
+            "channel {ch}: {}",
+            inside / quad
+        );
+    }
+    assert_eq!((ball.radius(), ball.delta().radius()), (radius, radius));
+    let shown = format!("{ball:?}");
+    assert!(
+        shown.contains("SphereProfile") && shown.contains("5.0"),
+        "{shown}"
+    );
+    // Between 1 and 6 mm the difference is resolved: more than 3 standard errors, positive.
+    for ch in 0..3 {
+        for (centre, se) in ball.delta_se(ch) {
+            if (1.0..6.0).contains(&centre) {
+                let d = ball.delta().delta(ch, centre);
+                assert!(
+                    d > 3.0 * se && se > 0.0,
+                    "channel {ch}, {centre} mm: {d} ± {se}"
+                );
+            }
+        }
     }
     // Jensen's skin1 reduced mean free paths are 1.30 / 0.95 / 0.67 mm: red gains most.
     assert!(
