@@ -156,16 +156,14 @@ pub struct TranslucentShading {
 /// cases [`SphereProfile::new`] refuses; were one to reach here, the half-space's model is kept.
 pub fn material_model(t: &Translucent) -> Box<dyn Bssrdf> {
     let base = make_model(t.model, &t.medium);
-    match t.sphere_radius {
-        Some(radius) => {
-            let mm = radius / t.units_per_mm;
-            match SphereDelta::cached(&t.medium, mm) {
-                Ok(delta) if t.model != ModelKind::DirectionalDipole => {
-                    Box::new(SphereProfile::with_delta(base, delta))
-                }
-                _ => base,
-            }
+    let delta = match t.sphere_radius {
+        Some(radius) if t.model != ModelKind::DirectionalDipole => {
+            SphereDelta::cached(&t.medium, radius / t.units_per_mm).ok()
         }
+        _ => None,
+    };
+    match delta {
+        Some(delta) => Box::new(SphereProfile::with_delta(base, delta)),
         None => base,
     }
 }

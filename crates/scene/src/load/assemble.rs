@@ -3,7 +3,7 @@
 //! warning.
 
 use super::context::{Ctx, list};
-use crate::format::SceneFile;
+use crate::format::{RadiusDef, SceneFile};
 use crate::{Material, MaterialKind, Object, Scene, SceneError};
 use std::collections::HashMap;
 
@@ -68,10 +68,13 @@ impl Ctx<'_> {
                 curvature,
             });
         }
-        // `sphere_radius = "auto"` is held as +∞ until the objects are known.
+        // `sphere_radius = "auto"` needs the objects: resolved here, from the parsed table.
         for (index, material) in materials.iter_mut().enumerate() {
+            let auto = def.materials.get(&material.name).is_some_and(
+                |m| matches!(&m.sphere_radius, Some(RadiusDef::Keyword(k)) if k == "auto"),
+            );
             if let MaterialKind::Translucent(t) = &mut material.kind
-                && t.sphere_radius == Some(f64::INFINITY)
+                && auto
             {
                 t.sphere_radius = Some(self.auto_sphere_radius(&objects, index, &material.name)?);
             }

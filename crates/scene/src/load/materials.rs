@@ -162,8 +162,8 @@ impl Ctx<'_> {
                              S is not radial (choose a radial model or leave `sphere_radius` out)",
                         ));
                     }
-                    // Resolved from the material's objects once they are loaded.
-                    Some(RadiusDef::Keyword(k)) if k == "auto" => Some(f64::INFINITY),
+                    // Resolved from the material's objects once they are loaded (`assemble`).
+                    Some(RadiusDef::Keyword(k)) if k == "auto" => None,
                     Some(RadiusDef::Keyword(k)) => {
                         return Err(self.err(
                             &key("sphere_radius"),
