@@ -39,6 +39,10 @@
 //!   ([`monte_carlo::simulate_sphere`], tallied by chord distance, which a sphere's hat-box
 //!   area πr² turns into a radial profile on [0, 2R]) minus the walk in the half-space, added
 //!   to the model's profile ([`SphereProfile`]; the scene format's `sphere_radius`).
+//! - [`entry_drift`] gives where obliquely entering light leaves: the first azimuthal harmonic
+//!   k(r, θ_i) of the same walk's exit density about the light's direction along the surface
+//!   ([`EntryDrift`]), for a renderer to multiply S by 1 + k(r, θ_i) cos φ_i + k(r, θ_o)
+//!   cos φ_o (the exit's term by reciprocity; the scene format's `drift`).
 //!
 //! ## Papers implemented
 //! - Jensen, Marschner, Levoy, Hanrahan. *A Practical Model for Subsurface Light Transport.*
@@ -67,9 +71,11 @@
 
 pub mod angular;
 pub mod better_dipole;
+mod binned;
 pub mod catmull_rom;
 pub mod christensen_burley;
 pub mod directional_dipole;
+pub mod entry_drift;
 mod error;
 pub mod fresnel;
 mod inversion;
@@ -92,6 +98,7 @@ pub use angular::DirectionalAlbedo;
 pub use better_dipole::BetterDipole;
 pub use christensen_burley::{BurleyFit, ChristensenBurley};
 pub use directional_dipole::DirectionalDipole;
+pub use entry_drift::EntryDrift;
 pub use error::BssrdfError;
 pub use glam::DVec3;
 pub use inversion::from_reflectance;

@@ -289,6 +289,25 @@ struct Walk<'a> {
 }
 
 impl Walk<'_> {
+    /// A walk with analog absorption and the event cap whose caller tallies escapes itself
+    /// (no bins): extinction `sigma_t`, albedo `albedo` (clamped to [0, 1]), anisotropy `g`,
+    /// relative index `eta`, in the half-space or the ball of radius `sphere`.
+    fn unbinned(sigma_t: f64, albedo: f64, g: f64, eta: f64, sphere: Option<f64>) -> Self {
+        Walk {
+            sigma_t,
+            albedo: albedo.clamp(0.0, 1.0),
+            g,
+            eta_out: 1.0 / eta,
+            analog: true,
+            max_events: MAX_SCATTERING_EVENTS,
+            inv_dr: 0.0,
+            r_max: 0.0,
+            bins: 1,
+            edges: None,
+            sphere,
+        }
+    }
+
     /// The radial bin holding exit radius `r`, or `None` beyond `r_max`.
     fn bin(&self, r: f64) -> Option<usize> {
         match self.edges {
@@ -440,14 +459,14 @@ fn scatter_direction(d: DVec3, cos_theta: f64, cos_phi: f64, sin_phi: f64) -> DV
 }
 
 /// Traces one photon that starts at the origin heading along `start` (a unit vector into the
-/// medium, d_z < 0), calling `escape(r, weight, collisions)` for every weight that leaves
-/// through the boundary at radius `r` after `collisions` collisions. Returns `Some(weight)` if
-/// it hit the event cap still carrying `weight`.
+/// medium, d_z < 0), calling `escape(p, r, weight, collisions)` for every weight that leaves
+/// through the boundary at the point `p` (radius, or chord in a ball, `r`) after `collisions`
+/// collisions. Returns `Some(weight)` if it hit the event cap still carrying `weight`.
 fn trace_photon(
     walk: &Walk,
     start: DVec3,
     rng: &mut Pcg64Mcg,
-    escape: &mut impl FnMut(f64, f64, u64),
+    escape: &mut impl FnMut(DVec3, f64, f64, u64),
 ) -> Option<f64> {
     let mut p = DVec3::ZERO;
     let mut d = start;
@@ -478,7 +497,7 @@ fn trace_photon(
                     let f = fr_dielectric(d.z, walk.eta_out);
                     let escaped = w * (1.0 - f);
                     if escaped > 0.0 {
-                        escape(p.x.hypot(p.y), escaped, events);
+                        escape(p, p.x.hypot(p.y), escaped, events);
                     }
                     w *= f;
                     if w <= 0.0 {
@@ -533,7 +552,7 @@ fn sphere_boundary(
     d: &mut DVec3,
     w: &mut f64,
     events: u64,
-    escape: &mut impl FnMut(f64, f64, u64),
+    escape: &mut impl FnMut(DVec3, f64, f64, u64),
 ) -> SphereStep {
     let centre = DVec3::new(0.0, 0.0, -radius);
     let q = *p - centre;
@@ -552,7 +571,7 @@ fn sphere_boundary(
     let f = fr_dielectric(cos, walk.eta_out);
     let escaped = *w * (1.0 - f);
     if escaped > 0.0 && events > 0 {
-        escape(p.length(), escaped, events);
+        escape(*p, p.length(), escaped, events);
     }
     *w *= f;
     if *w <= 0.0 {
@@ -584,7 +603,7 @@ fn run_chunk(walk: &Walk, photons: u64, seed: u64) -> Tally {
         total: 0.0,
     };
     for _ in 0..photons {
-        let traced = trace_photon(walk, DVec3::NEG_Z, &mut rng, &mut |r, w, events| {
+        let traced = trace_photon(walk, DVec3::NEG_Z, &mut rng, &mut |_, r, w, events| {
             scratch.deposit(walk, r, w);
             if events == 1 {
                 scratch.deposit_single(walk, r, w);
@@ -618,20 +637,36 @@ pub(crate) fn condensed_escapes(
     rng: &mut Pcg64Mcg,
     escape: &mut impl FnMut(u64, f64),
 ) {
-    let walk = Walk {
-        sigma_t: 1.0,
-        albedo: albedo.clamp(0.0, 1.0),
-        g,
-        eta_out: 1.0 / eta,
-        analog: true,
-        max_events: MAX_SCATTERING_EVENTS,
-        inv_dr: 0.0,
-        r_max: 0.0,
-        bins: 1,
-        edges: None,
-        sphere: None,
-    };
-    trace_photon(&walk, start, rng, &mut |_, w, n| escape(n, w));
+    let walk = Walk::unbinned(1.0, albedo, g, eta, None);
+    trace_photon(&walk, start, rng, &mut |_, _, w, n| escape(n, w));
+}
+
+/// One photon's walk in channel `ch` of `medium` (lengths in mm) with analog absorption,
+/// in the half-space (`sphere` `None`) or in the ball of radius `sphere` under the entry point
+/// (centred at (0, 0, −R)), starting at the origin heading along `start` (unit, d_z < 0) with
+/// weight 1. Calls `escape(p, weight, collisions)` for each weight leaving at the point `p`
+/// after `collisions` ≥ 1 collisions (light crossing without a collision is not diffuse). Used by
+/// [`crate::entry_drift::EntryDrift`].
+pub(crate) fn walk_escapes(
+    medium: &Medium,
+    ch: usize,
+    sphere: Option<f64>,
+    start: DVec3,
+    rng: &mut Pcg64Mcg,
+    escape: &mut impl FnMut(DVec3, f64, u64),
+) {
+    let walk = Walk::unbinned(
+        medium.sigma_t(ch),
+        medium.albedo(ch),
+        medium.g(),
+        medium.eta(),
+        sphere,
+    );
+    trace_photon(&walk, start, rng, &mut |p, _, w, n| {
+        if n > 0 {
+            escape(p, w, n);
+        }
+    });
 }
 
 /// Standard error of the mean of N samples with sums `s`, `s2`.

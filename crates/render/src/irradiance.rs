@@ -11,7 +11,8 @@
 //! the channels) from every shaded point adds less than that fraction of what it would add
 //! beside one, so a large object seen close up is sampled where it is seen, at the spacing
 //! asked for, instead of all over at a spacing the per-object cap coarsens. For the
-//! directional dipole, whose S depends on the incident direction, each sample also keeps its
+//! directional dipole, whose S depends on the incident direction, and for a drifting material
+//! (`drift = true`, whose light leaves ahead of its direction), each sample also keeps its
 //! incident light packets.
 //!
 //! [`Bssrdf::radius_for_energy`]: sss_bssrdf::Bssrdf::radius_for_energy
@@ -72,9 +73,10 @@ pub struct ObjectSamples {
     pub mfp: f64,
     /// The samples.
     pub samples: Vec<IrradianceSample>,
-    /// Directional-dipole objects only: every sample's incident light packets (texture
-    /// applied, no Fresnel factor), `incident[incident_offsets[i]..incident_offsets[i + 1]]`
-    /// for sample i. Empty for separable models.
+    /// Directional-dipole and drifting objects only (`drift = true`): every sample's incident
+    /// light packets (texture applied, no Fresnel factor),
+    /// `incident[incident_offsets[i]..incident_offsets[i + 1]]` for sample i. Empty for the
+    /// others.
     pub incident: Vec<Incident>,
     /// Offsets into `incident` (length samples + 1), or empty.
     pub incident_offsets: Vec<u32>,
@@ -250,7 +252,8 @@ fn compute_within(
                 }
                 _ => 0,
             };
-            let directional = mat.model == ModelKind::DirectionalDipole;
+            // The directional dipole and a drifting model need each packet's direction.
+            let directional = mat.model == ModelKind::DirectionalDipole || mat.drift;
             let weights = BoundaryWeights::of(mat);
             let lit: Vec<(IrradianceSample, Vec<Incident>)> = points
                 .par_iter()

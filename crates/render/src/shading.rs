@@ -21,8 +21,8 @@ use crate::lights::Incident;
 use glam::DVec3;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{
-    Bssrdf, DirectionalAlbedo, ModelKind, Rgb, SphereDelta, SphereProfile, fresnel_normalization,
-    make_model,
+    Bssrdf, DirectionalAlbedo, EntryDrift, ModelKind, Rgb, SphereDelta, SphereProfile,
+    fresnel_normalization, make_model,
 };
 use sss_scene::{Angular, Scene, Texture, Translucent};
 use std::f64::consts::PI;
@@ -86,6 +86,16 @@ impl BoundaryWeights {
         }
     }
 
+    /// W_i of one packet arriving from direction `dir` at a point with shading normal `n`,
+    /// per channel (the factor [`Self::entering`] gives that packet).
+    #[inline]
+    pub fn entry_weight(&self, n: DVec3, dir: DVec3) -> Rgb {
+        match self {
+            BoundaryWeights::Fresnel { eta, .. } => [ft_dielectric(n.dot(dir), *eta); 3],
+            BoundaryWeights::Albedo { eta, table } => table.entry_weight(n.dot(dir).abs(), *eta),
+        }
+    }
+
     /// W_o at a point with shading normal `n` seen from `wo`, per channel.
     pub fn leaving(&self, n: DVec3, wo: DVec3) -> Rgb {
         match self {
@@ -145,6 +155,8 @@ pub struct TranslucentShading {
     pub texture: Option<Texture>,
     /// The angular factors of the material's radial model.
     pub weights: BoundaryWeights,
+    /// The walk's drift of obliquely entering light (`drift = true`), or `None`.
+    pub drift: Option<Arc<EntryDrift>>,
     /// The disk-average quadrature of [`rd_sample_scene`](Self::rd_sample_scene).
     disk: DiskRule,
 }
@@ -179,6 +191,13 @@ impl TranslucentShading {
             ShadingModel::Radial(bssrdf)
         };
         let disk = DiskRule::new(model.bssrdf(), &t.medium, t.units_per_mm);
+        // The loader refuses `drift` on the directional dipole; the walk refuses only radii
+        // the loader refuses too.
+        let drift = if t.drift && t.model != ModelKind::DirectionalDipole {
+            EntryDrift::cached(&t.medium, t.sphere_radius.map(|r| r / t.units_per_mm)).ok()
+        } else {
+            None
+        };
         TranslucentShading {
             name: name.to_string(),
             kind: t.model,
@@ -188,6 +207,7 @@ impl TranslucentShading {
             norm: 1.0 / (fresnel_normalization(eta) * PI),
             texture: t.texture.clone(),
             weights: BoundaryWeights::of(t),
+            drift,
             disk,
         }
     }
@@ -482,10 +502,75 @@ impl TranslucentShading {
         }
     }
 
+    /// The irradiance entering at `xi` (shading normal `ni`) that leaves `xo` (shading
+    /// normal `no`) towards `wo`: Σ_k W_i(θ_k) E_k, each packet times the drift's reciprocal
+    /// factor 1 + k(r, θ_k) cos φ_k + k(r, θ_o) cos φ_o ([`EntryDrift::factor`]): φ_k
+    /// between the packet's direction of travel along the surface at `xi` and the direction
+    /// from `xi` towards `xo` along it, φ_o between the view ray's direction of travel (−`wo`)
+    /// along the surface at `xo` and the direction from `xo` towards `xi` along it, r =
+    /// |xo − xi| in mm. The packets carry the texture already. Without drift Σ_k W_i(θ_k) E_k.
+    pub fn entering_towards(
+        &self,
+        packets: &[Incident],
+        (xi, ni): (DVec3, DVec3),
+        (xo, no, wo): (DVec3, DVec3, DVec3),
+    ) -> Rgb {
+        let mut e = [0.0; 3];
+        let Some(drift) = &self.drift else {
+            for packet in packets {
+                let w = self.weights.entry_weight(ni, packet.dir);
+                for c in 0..3 {
+                    e[c] += w[c] * packet.e_cos[c];
+                }
+            }
+            return e;
+        };
+        let r = (xo - xi).length() / self.units_per_mm;
+        let cos_phi_o = along_surface_cos(-wo, xi - xo, no);
+        let cos_o = no.dot(wo).abs();
+        for packet in packets {
+            let w = self.weights.entry_weight(ni, packet.dir);
+            let cos_phi_i = along_surface_cos(-packet.dir, xo - xi, ni);
+            let m = drift.factor(r, ni.dot(packet.dir).abs(), cos_phi_i, cos_o, cos_phi_o);
+            for c in 0..3 {
+                e[c] += w[c] * m[c] * packet.e_cos[c];
+            }
+        }
+        e
+    }
+
+    /// Ok when the material does not drift; otherwise an error naming the material and
+    /// `method`, which sums one irradiance per point (only `exact` and `pathtrace` keep each
+    /// packet's direction).
+    pub fn no_drift(&self, method: &str) -> Result<(), crate::Error> {
+        if self.drift.is_none() {
+            Ok(())
+        } else {
+            Err(crate::Error::Unsupported(format!(
+                "material `{}`: method {method} sums one irradiance per point; `drift = true` \
+                 needs each light's direction at each point (use exact or pathtrace)",
+                self.name
+            )))
+        }
+    }
+
     /// The pre-scatter texture at `p` (1 without a texture).
     #[inline]
     pub fn texture_at(&self, p: DVec3) -> Rgb {
         self.texture.as_ref().map_or([1.0; 3], |t| t.eval(p))
+    }
+}
+
+/// The cosine between the components of `a` and `b` along the surface of normal `n` (their
+/// projections on its tangent plane); 0 when either has none.
+fn along_surface_cos(a: DVec3, b: DVec3, n: DVec3) -> f64 {
+    let pa = a - n * a.dot(n);
+    let pb = b - n * b.dot(n);
+    let l = pa.length() * pb.length();
+    if l > 1e-12 && l.is_finite() {
+        (pa.dot(pb) / l).clamp(-1.0, 1.0)
+    } else {
+        0.0
     }
 }
 
@@ -688,6 +773,7 @@ mod tests {
                 texture: None,
                 angular: Default::default(),
                 sphere_radius: None,
+                drift: false,
             },
         )
     }

@@ -73,6 +73,7 @@ pub(super) struct MaterialDef {
     pub texture: Option<TextureDef>,
     pub angular: Option<String>,
     pub sphere_radius: Option<RadiusDef>,
+    pub drift: Option<bool>,
 }
 
 /// `sphere_radius = 12.5` (scene units) or `sphere_radius = "auto"`.
@@ -168,6 +169,7 @@ impl Keys for MaterialDef {
             ("texture", self.texture.is_some()),
             ("angular", self.angular.is_some()),
             ("sphere_radius", self.sphere_radius.is_some()),
+            ("drift", self.drift.is_some()),
         ])
     }
 }

@@ -193,6 +193,10 @@ pub struct Translucent {
     /// The file gives a length or `"auto"`: 3 V/A of the material's objects (their volume
     /// over their area, the radius of a ball for a ball).
     pub sphere_radius: Option<f64>,
+    /// Whether the light entering at an angle leaves ahead of its entry point, as the random
+    /// walk says (`sss_bssrdf::EntryDrift`: S times 1 + k(r, θ_i) cos φ), instead of evenly
+    /// around it (false, the default).
+    pub drift: bool,
 }
 
 /// The angular factors of a radial model, S = W_i(θ_i) R_d(r) W_o(θ_o).

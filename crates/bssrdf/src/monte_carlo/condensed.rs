@@ -341,41 +341,46 @@ fn run_chunk(
         weights: vec![0.0; rows],
     };
     for _ in 0..photons {
-        let traced = trace_photon(walk, crate::DVec3::NEG_Z, &mut rng, &mut |r, w, events| {
-            if events < min_events {
-                return;
-            }
-            // Collisions are counted up to the cap (≤ 10⁶), which fits an i32.
-            let n = events.min(i32::MAX as u64) as i32;
-            for (x, &q) in scratch.weights.iter_mut().zip(ratios) {
-                *x = w * q.powi(n);
-            }
-            for (t, x) in scratch.total.iter_mut().zip(&scratch.weights) {
-                *t += x;
-            }
-            if scales.is_empty() {
-                if let Some(b) = walk.bin(r) {
-                    if !scratch.is_touched[b] {
-                        scratch.is_touched[b] = true;
-                        scratch.touched.push(b);
-                    }
-                    let cell = &mut scratch.cell[b * rows..(b + 1) * rows];
-                    for (c, x) in cell.iter_mut().zip(&scratch.weights) {
-                        *c += x;
-                    }
+        let traced = trace_photon(
+            walk,
+            crate::DVec3::NEG_Z,
+            &mut rng,
+            &mut |_, r, w, events| {
+                if events < min_events {
+                    return;
                 }
-            } else {
-                for (i, (&s, x)) in scales.iter().zip(&scratch.weights).enumerate() {
-                    if let Some(b) = walk.bin(s * r) {
+                // Collisions are counted up to the cap (≤ 10⁶), which fits an i32.
+                let n = events.min(i32::MAX as u64) as i32;
+                for (x, &q) in scratch.weights.iter_mut().zip(ratios) {
+                    *x = w * q.powi(n);
+                }
+                for (t, x) in scratch.total.iter_mut().zip(&scratch.weights) {
+                    *t += x;
+                }
+                if scales.is_empty() {
+                    if let Some(b) = walk.bin(r) {
                         if !scratch.is_touched[b] {
                             scratch.is_touched[b] = true;
                             scratch.touched.push(b);
                         }
-                        scratch.cell[b * rows + i] += x;
+                        let cell = &mut scratch.cell[b * rows..(b + 1) * rows];
+                        for (c, x) in cell.iter_mut().zip(&scratch.weights) {
+                            *c += x;
+                        }
+                    }
+                } else {
+                    for (i, (&s, x)) in scales.iter().zip(&scratch.weights).enumerate() {
+                        if let Some(b) = walk.bin(s * r) {
+                            if !scratch.is_touched[b] {
+                                scratch.is_touched[b] = true;
+                                scratch.touched.push(b);
+                            }
+                            scratch.cell[b * rows + i] += x;
+                        }
                     }
                 }
-            }
-        });
+            },
+        );
         if let Some(w) = traced {
             tally.capped += 1;
             let n = walk.max_events.min(i32::MAX as u64) as i32;

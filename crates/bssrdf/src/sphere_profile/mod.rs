@@ -49,6 +49,7 @@
 //! assert_eq!(ball.rd(0, 25.0), 0.0); // no point of the ball is 20 mm or more away
 //! ```
 
+use crate::binned::{between_centres, memoized};
 use crate::monte_carlo::{self, BinSpacing, McConfig};
 use crate::radial::RadialTable;
 use crate::{Bssrdf, BssrdfError, Medium, ModelKind};
@@ -85,20 +86,7 @@ struct DeltaRow {
 impl DeltaRow {
     /// Δ at `r`: linear between bin centres, the end bins' values beyond them.
     fn at(&self, r: f64) -> f64 {
-        let c = &self.centres;
-        if c.is_empty() {
-            return 0.0;
-        }
-        let i = c.partition_point(|&x| x <= r);
-        if i == 0 {
-            return self.delta[0];
-        }
-        if i == c.len() {
-            return self.delta[c.len() - 1];
-        }
-        let (a, b) = (c[i - 1], c[i]);
-        let t = if b > a { (r - a) / (b - a) } else { 0.0 };
-        self.delta[i - 1] + t * (self.delta[i] - self.delta[i - 1])
+        between_centres(&self.centres, &self.delta, r)
     }
 }
 
@@ -166,19 +154,11 @@ impl SphereDelta {
     /// The difference of one medium and radius, computed once per process and shared (the
     /// walks take from a fraction of a second to seconds per medium).
     pub fn cached(medium: &Medium, radius: f64) -> Result<Arc<SphereDelta>, BssrdfError> {
-        type Key = ([u64; 8], u64);
-        static CACHE: OnceLock<Mutex<HashMap<Key, Arc<SphereDelta>>>> = OnceLock::new();
-        let key: Key = (medium.bits(), radius.to_bits());
-        let cache = CACHE.get_or_init(Default::default);
-        if let Some(d) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-            return Ok(Arc::clone(d));
-        }
-        let d = Arc::new(SphereDelta::new(medium, radius)?);
-        cache
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .insert(key, Arc::clone(&d));
-        Ok(d)
+        type Cache = Mutex<HashMap<([u64; 8], u64), Arc<SphereDelta>>>;
+        static CACHE: OnceLock<Cache> = OnceLock::new();
+        memoized(&CACHE, (medium.bits(), radius.to_bits()), || {
+            SphereDelta::new(medium, radius)
+        })
     }
 
     /// The ball's radius (mm).

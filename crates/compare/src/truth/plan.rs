@@ -147,6 +147,16 @@ pub(crate) fn with_ball_profile(scene: &mut Scene) {
     }
 }
 
+/// Gives every translucent material of `scene` the walk's drift of obliquely entering light
+/// (`drift = true`).
+pub(crate) fn with_drift(scene: &mut Scene) {
+    for m in &mut scene.materials {
+        if let MaterialKind::Translucent(t) = &mut m.kind {
+            t.drift = true;
+        }
+    }
+}
+
 /// What one run of the experiment does.
 #[derive(Clone, Debug)]
 pub(crate) struct Plan {

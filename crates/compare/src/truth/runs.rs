@@ -28,8 +28,12 @@ pub const ALBEDO_MODEL: &str = "mc-table+albedo";
 /// of a ball of the object's volume-to-area ratio) in the runs' `model` column.
 pub const BALL_MODEL: &str = "mc-table+albedo+ball";
 
+/// The name of [`BALL_MODEL`] with `drift = true` (obliquely entering light leaves ahead of its
+/// entry point, as the random walk says) in the runs' `model` column.
+pub const DRIFT_MODEL: &str = "mc-table+albedo+ball+drift";
+
 /// The models beyond [`ModelKind::ALL`] the experiment scores, in report order.
-pub const VARIANTS: [&str; 2] = [ALBEDO_MODEL, BALL_MODEL];
+pub const VARIANTS: [&str; 3] = [ALBEDO_MODEL, BALL_MODEL, DRIFT_MODEL];
 
 /// One run scored against the truth.
 #[derive(Clone, Debug, PartialEq)]
@@ -131,8 +135,8 @@ pub(crate) fn run_case(
     };
     // Every model, and `mc-table` with the half-space's directional albedo for its angular
     // factors (`angular = "albedo"`, the model the measured deficit led to), then also with the
-    // profile of the ball of the object's volume-to-area ratio (`sphere_radius = "auto"`):
-    // (name, scene).
+    // profile of the ball of the object's volume-to-area ratio (`sphere_radius = "auto"`), then
+    // with the walk's drift too (`drift = true`): (name, scene).
     let variant = |k: usize| -> Result<(&'static str, Scene), Error> {
         match ModelKind::ALL.get(k) {
             Some(&model) => Ok((model.name(), scene_for(model)?)),
@@ -140,8 +144,11 @@ pub(crate) fn run_case(
                 let mut scene = scene_for(ModelKind::McTable)?;
                 with_albedo_weights(&mut scene);
                 let name = VARIANTS[k - ModelKind::ALL.len()];
-                if name == BALL_MODEL {
+                if name == BALL_MODEL || name == DRIFT_MODEL {
                     with_ball_profile(&mut scene);
+                }
+                if name == DRIFT_MODEL {
+                    with_drift(&mut scene);
                 }
                 Ok((name, scene))
             }

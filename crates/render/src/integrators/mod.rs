@@ -243,11 +243,23 @@ pub(crate) fn pixel_std_error(gb: &GBuffer, variances: &[Rgb]) -> Vec<Rgb> {
         .collect()
 }
 
-/// Errors unless every visible translucent material is radial.
+/// Errors when a visible translucent material drifts (`drift = true`), for methods that sum
+/// one irradiance per point.
+pub(crate) fn check_no_drift(frame: &Frame<'_>, method: &str) -> Result<(), Error> {
+    for &o in &frame.visible {
+        if let Some(sh) = frame.shading_of(o) {
+            sh.no_drift(method)?;
+        }
+    }
+    Ok(())
+}
+
+/// Errors unless every visible translucent material is radial and does not drift.
 pub(crate) fn check_radial(frame: &Frame<'_>, method: &str) -> Result<(), Error> {
     for &o in &frame.visible {
         if let Some(sh) = frame.shading_of(o) {
             sh.radial(method)?;
+            sh.no_drift(method)?;
         }
     }
     Ok(())

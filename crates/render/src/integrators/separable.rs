@@ -161,6 +161,7 @@ impl Integrator for Separable {
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        super::check_no_drift(frame, METHOD.name)?;
         let scene = frame.scene;
         // Fresnel-transmitted, textured irradiance at every translucent pixel sample.
         let irradiance: Vec<Rgb> = frame.timed("irradiance", || {

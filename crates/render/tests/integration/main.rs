@@ -9,6 +9,7 @@ mod closed_forms;
 mod common;
 mod disk_average;
 mod dual_tree_fmm;
+mod entry_drift;
 mod exr_budget;
 mod flip_evaluator;
 mod fuzz_regressions;

@@ -29,6 +29,7 @@ impl Ctx<'_> {
                         "texture",
                         "angular",
                         "sphere_radius",
+                        "drift",
                     ],
                     what,
                 )?;
@@ -186,6 +187,15 @@ impl Ctx<'_> {
                         Some(*r)
                     }
                 };
+                let drift = m.drift.unwrap_or(false);
+                if drift && model == ModelKind::DirectionalDipole {
+                    return Err(self.err(
+                        &key("drift"),
+                        "drift moves a radial model's light along the entry direction; the \
+                         directional dipole's S has its own (choose a radial model or leave \
+                         `drift` out)",
+                    ));
+                }
                 Ok(MaterialKind::Translucent(Translucent {
                     model,
                     medium,
@@ -193,6 +203,7 @@ impl Ctx<'_> {
                     texture,
                     angular,
                     sphere_radius,
+                    drift,
                 }))
             }
             "diffuse" => {

@@ -571,6 +571,38 @@ fn sphere_radius() {
     assert!(e.to_string().contains("enclose no volume"), "{e}");
 }
 
+/// `drift`: off by default, `true` or `false`, refused on the directional dipole (its S has
+/// its own) and for anything but a boolean.
+#[test]
+fn drift() {
+    let jelly = |s: &sss_scene::Scene| match &s.materials[1].kind {
+        MaterialKind::Translucent(t) => t.drift,
+        _ => panic!("jelly is translucent"),
+    };
+    let s = load_str(GOOD, "good.toml", None, &no_dirs()).unwrap();
+    assert!(!jelly(&s));
+    for (v, want) in [("true", true), ("false", false)] {
+        let text = with("eta = 1.4", &format!("eta = 1.4\ndrift = {v}"));
+        let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+        assert_eq!(jelly(&s), want, "drift = {v}");
+    }
+    assert_err(
+        &with(
+            "model = \"directional-dipole\"",
+            "model = \"directional-dipole\"\ndrift = true",
+        ),
+        Some("drift = true"),
+        Some("materials.skin.drift"),
+        &["directional dipole", "radial model"],
+    );
+    assert_err(
+        &with("eta = 1.4", "eta = 1.4\ndrift = \"yes\""),
+        Some("drift = \"yes\""),
+        Some("materials.jelly.drift"),
+        &["expected a boolean"],
+    );
+}
+
 #[test]
 fn material_errors() {
     assert_err(

@@ -136,6 +136,7 @@ pub fn translucent(model: ModelKind, preset: &str, units_per_mm: f64) -> Materia
             texture: None,
             angular: Default::default(),
             sphere_radius: None,
+            drift: false,
         }),
     }
 }
