@@ -98,7 +98,7 @@ pub use angular::DirectionalAlbedo;
 pub use better_dipole::BetterDipole;
 pub use christensen_burley::{BurleyFit, ChristensenBurley};
 pub use directional_dipole::DirectionalDipole;
-pub use entry_drift::EntryDrift;
+pub use entry_drift::{DriftAt, EntryDrift};
 pub use error::BssrdfError;
 pub use glam::DVec3;
 pub use inversion::from_reflectance;

@@ -21,7 +21,7 @@ use crate::lights::Incident;
 use glam::DVec3;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{
-    Bssrdf, DirectionalAlbedo, EntryDrift, ModelKind, Rgb, SphereDelta, SphereProfile,
+    Bssrdf, DirectionalAlbedo, DriftAt, EntryDrift, ModelKind, Rgb, SphereDelta, SphereProfile,
     fresnel_normalization, make_model,
 };
 use sss_scene::{Angular, Scene, Texture, Translucent};
@@ -525,13 +525,14 @@ impl TranslucentShading {
             }
             return e;
         };
-        let r = (xo - xi).length() / self.units_per_mm;
+        let at = drift.at((xo - xi).length() / self.units_per_mm);
         let cos_phi_o = along_surface_cos(-wo, xi - xo, no);
-        let cos_o = no.dot(wo).abs();
+        let ko = at.ks(no.dot(wo).abs());
         for packet in packets {
             let w = self.weights.entry_weight(ni, packet.dir);
             let cos_phi_i = along_surface_cos(-packet.dir, xo - xi, ni);
-            let m = drift.factor(r, ni.dot(packet.dir).abs(), cos_phi_i, cos_o, cos_phi_o);
+            let ki = at.ks(ni.dot(packet.dir).abs());
+            let m = DriftAt::combine(ki, cos_phi_i, ko, cos_phi_o);
             for c in 0..3 {
                 e[c] += w[c] * m[c] * packet.e_cos[c];
             }

@@ -332,29 +332,17 @@ impl EntryDrift {
 
     /// k(r, θ_i) of channel `ch` at chord `r` (mm) for light entering at outside incidence
     /// cosine `cos_i`: in [−1, 1], 0 at normal incidence; linear in cos θ_i between
-    /// [`COS_NODES`] (the first node's value below it).
+    /// [`COS_NODES`] (the first node's value below it). [`EntryDrift::at`] then
+    /// [`DriftAt::ks`] reads many incidences at one chord faster.
     pub fn k(&self, ch: usize, r: f64, cos_i: f64) -> f64 {
-        let rows = &self.rows[ch];
-        let c = if cos_i.is_finite() {
-            cos_i.clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
-        let last = COS_NODES.len() - 1;
-        let value = if c <= COS_NODES[0] {
-            rows[0].at(r)
-        } else if c >= COS_NODES[last] {
-            let t = (1.0 - c) / (1.0 - COS_NODES[last]);
-            t * rows[last].at(r)
-        } else {
-            let j = COS_NODES.partition_point(|&x| x <= c) - 1;
-            let t = (c - COS_NODES[j]) / (COS_NODES[j + 1] - COS_NODES[j]);
-            (1.0 - t) * rows[j].at(r) + t * rows[j + 1].at(r)
-        };
-        if value.is_finite() {
-            value.clamp(-1.0, 1.0)
-        } else {
-            0.0
+        self.at(r).ks(cos_i)[ch]
+    }
+
+    /// Every channel's k at every incidence node at chord `r` (mm), read once for the many
+    /// incidences of one pair of points.
+    pub fn at(&self, r: f64) -> DriftAt {
+        DriftAt {
+            nodes: std::array::from_fn(|ch| std::array::from_fn(|j| self.rows[ch][j].at(r))),
         }
     }
 
@@ -377,6 +365,52 @@ impl EntryDrift {
     /// the exit (−ω_o's) and the direction from the exit towards the entry point (see the
     /// module documentation: the entry's term is the walk's, the exit's its reciprocal).
     pub fn factor(&self, r: f64, cos_i: f64, cos_phi_i: f64, cos_o: f64, cos_phi_o: f64) -> Rgb {
+        let at = self.at(r);
+        DriftAt::combine(at.ks(cos_i), cos_phi_i, at.ks(cos_o), cos_phi_o)
+    }
+}
+
+/// [`EntryDrift`] read at one chord: k per channel at each incidence node.
+#[derive(Clone, Copy, Debug)]
+pub struct DriftAt {
+    nodes: [[f64; COS_NODES.len()]; 3],
+}
+
+impl DriftAt {
+    /// k per channel for light entering (or, by reciprocity, leaving) at outside cosine
+    /// `cos`: linear between [`COS_NODES`], the first node's value below it, to 0 at 1; in
+    /// [−1, 1].
+    pub fn ks(&self, cos: f64) -> Rgb {
+        let c = if cos.is_finite() {
+            cos.clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let last = COS_NODES.len() - 1;
+        let (j, wj, wn) = if c <= COS_NODES[0] {
+            (0, 1.0, 0.0)
+        } else if c >= COS_NODES[last] {
+            (last, (1.0 - c) / (1.0 - COS_NODES[last]), 0.0)
+        } else {
+            let j = COS_NODES.partition_point(|&x| x <= c) - 1;
+            let t = (c - COS_NODES[j]) / (COS_NODES[j + 1] - COS_NODES[j]);
+            (j, 1.0 - t, t)
+        };
+        std::array::from_fn(|ch| {
+            let row = &self.nodes[ch];
+            let next = row.get(j + 1).copied().unwrap_or(0.0);
+            let value = wj * row[j] + wn * next;
+            if value.is_finite() {
+                value.clamp(-1.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// The factor 1 + k_i cos φ_i + k_o cos φ_o per channel from the entry's and the exit's k
+    /// ([`DriftAt::ks`]) and the two azimuth cosines (see [`EntryDrift::factor`]).
+    pub fn combine(ki: Rgb, cos_phi_i: f64, ko: Rgb, cos_phi_o: f64) -> Rgb {
         let clean = |x: f64| {
             if x.is_finite() {
                 x.clamp(-1.0, 1.0)
@@ -386,11 +420,10 @@ impl EntryDrift {
         };
         let (pi, po) = (clean(cos_phi_i), clean(cos_phi_o));
         std::array::from_fn(|ch| {
-            let (ki, ko) = (self.k(ch, r, cos_i), self.k(ch, r, cos_o));
             // |k_i| + |k_o| ≤ 1 keeps the factor ≥ 0 without a clamp, which would add light
             // (the factor's mean over either azimuth stays 1).
-            let s = (ki.abs() + ko.abs()).max(1.0);
-            (1.0 + (ki * pi + ko * po) / s).max(0.0)
+            let s = (ki[ch].abs() + ko[ch].abs()).max(1.0);
+            (1.0 + (ki[ch] * pi + ko[ch] * po) / s).max(0.0)
         })
     }
 }
