@@ -562,14 +562,15 @@ impl TranslucentShading {
     }
 }
 
-/// The cosine between the components of `a` and `b` along the surface of normal `n` (their
-/// projections on its tangent plane); 0 when either has none.
+/// The cosine between the components of `a` and `b` along the surface of unit normal `n`
+/// (their projections on its tangent plane); 0 when either has none (less than 10⁻⁹ of its
+/// length, whatever the scene's units).
 fn along_surface_cos(a: DVec3, b: DVec3, n: DVec3) -> f64 {
     let pa = a - n * a.dot(n);
     let pb = b - n * b.dot(n);
-    let l = pa.length() * pb.length();
-    if l > 1e-12 && l.is_finite() {
-        (pa.dot(pb) / l).clamp(-1.0, 1.0)
+    let (la, lb) = (pa.length(), pb.length());
+    if la > 1e-9 * a.length() && lb > 1e-9 * b.length() && (la * lb).is_finite() {
+        (pa.dot(pb) / (la * lb)).clamp(-1.0, 1.0)
     } else {
         0.0
     }
@@ -777,6 +778,93 @@ mod tests {
                 drift: false,
             },
         )
+    }
+
+    /// The cosine along the surface by hand: vectors in the tangent plane, out of it, and with
+    /// no tangential part, at scene scales from 10⁻⁶ to 10⁶ (the guard is relative).
+    #[test]
+    fn along_surface_cos_projects_on_the_tangent_plane() {
+        let n = DVec3::Z;
+        for s in [1e-6, 1.0, 1e6] {
+            let c = |a: DVec3, b: DVec3| along_surface_cos(a, b * s, n);
+            assert!((c(DVec3::X, DVec3::X) - 1.0).abs() < 1e-12);
+            assert!((c(DVec3::X, -DVec3::X) + 1.0).abs() < 1e-12);
+            assert!(c(DVec3::X, DVec3::Y).abs() < 1e-12);
+            // (1, 0, −5) and (1, 1, 3) along the surface: (1, 0) and (1, 1), 45° apart.
+            let v = c(DVec3::new(1.0, 0.0, -5.0), DVec3::new(1.0, 1.0, 3.0));
+            assert!((v - 0.5f64.sqrt()).abs() < 1e-12, "{v}");
+            assert_eq!(c(DVec3::Z, DVec3::X), 0.0);
+            assert_eq!(c(DVec3::X, DVec3::NEG_Z), 0.0);
+            assert_eq!(c(DVec3::X, DVec3::ZERO), 0.0);
+        }
+    }
+
+    /// A drifting material sends light arriving at 70° along +x to an exit point ahead of
+    /// the entry (+x) more than to one behind, and the two, like any pair at opposite azimuths
+    /// seen straight on, sum to twice the light without drift (the factor moves light); seen
+    /// straight on from a point beside the light's path (±y), nothing changes; without drift
+    /// every exit point gets the Fresnel-weighted irradiance.
+    #[test]
+    fn drift_moves_light_ahead_of_its_direction() {
+        let medium = Medium::preset("skin1").unwrap();
+        let plain = shading(ModelKind::McTable, medium.clone(), 1.0);
+        let mut t = Translucent {
+            model: ModelKind::McTable,
+            medium,
+            units_per_mm: 1.0,
+            texture: None,
+            angular: Default::default(),
+            sphere_radius: None,
+            drift: true,
+        };
+        let drifting = TranslucentShading::new("test", &t);
+        t.drift = false;
+        assert!(drifting.drift.is_some() && plain.drift.is_none());
+        let theta = 70f64.to_radians();
+        // From the point towards the light: the light travels along +x, downwards.
+        let packet = Incident {
+            dir: DVec3::new(-theta.sin(), 0.0, theta.cos()),
+            e_cos: [1.0, 2.0, 3.0],
+        };
+        let entry = (DVec3::ZERO, DVec3::Z);
+        let at = |sh: &TranslucentShading, x: DVec3| {
+            sh.entering_towards(&[packet], entry, (x, DVec3::Z, DVec3::Z))
+        };
+        let none = at(&plain, DVec3::X);
+        let f = ft_dielectric(theta.cos(), plain.eta);
+        for c in 0..3 {
+            assert!((none[c] - f * packet.e_cos[c]).abs() < 1e-12, "{none:?}");
+        }
+        for d in [0.3, 1.0, 3.0] {
+            let ahead = at(&drifting, DVec3::X * d);
+            let behind = at(&drifting, -DVec3::X * d);
+            let side = at(&drifting, DVec3::Y * d);
+            for c in 0..3 {
+                assert!(
+                    ahead[c] > 1.1 * behind[c],
+                    "{d} mm, channel {c}: {ahead:?} {behind:?}"
+                );
+                assert!((ahead[c] + behind[c] - 2.0 * none[c]).abs() < 1e-12 * none[c]);
+                assert!((side[c] - none[c]).abs() < 1e-12 * none[c]);
+            }
+        }
+        // The exit's term: seen at 60° from a point the view ray travels towards, the light
+        // from behind the view ray's path along the surface is dimmed, from ahead brightened.
+        let wo = DVec3::new(-60f64.to_radians().sin(), 0.0, 60f64.to_radians().cos());
+        let normal_entry = Incident {
+            dir: DVec3::Z,
+            e_cos: [1.0; 3],
+        };
+        let seen =
+            |xo: DVec3| drifting.entering_towards(&[normal_entry], entry, (xo, DVec3::Z, wo));
+        // The view ray travels along +x at xo; the entry point is ahead of it when xo is at −x.
+        let (ahead, behind) = (seen(-DVec3::X), seen(DVec3::X));
+        for c in 0..3 {
+            assert!(
+                ahead[c] > 1.1 * behind[c],
+                "exit, channel {c}: {ahead:?} {behind:?}"
+            );
+        }
     }
 
     /// The media of the tests: two measured ones (Jensen et al. 2001) and ketchup, whose green

@@ -164,12 +164,16 @@ impl Sums {
 }
 
 /// The start direction of light refracted from outside cosine `cos_i` through index `eta`:
-/// along +x on the surface, into the medium (d_z < 0). Snell: sin θ_t = sin θ_i / η.
-fn refracted(cos_i: f64, eta: f64) -> DVec3 {
+/// along +x on the surface, into the medium (d_z < 0). Snell: sin θ_t = sin θ_i / η. `None`
+/// beyond the critical angle of a medium less dense than outside (η < 1): no light enters.
+fn refracted(cos_i: f64, eta: f64) -> Option<DVec3> {
     let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
-    let sin_t = (sin_i / eta).min(1.0);
+    let sin_t = sin_i / eta;
+    if !(sin_t < 1.0 - 1e-9) {
+        return None;
+    }
     let cos_t = (1.0 - sin_t * sin_t).max(0.0).sqrt();
-    DVec3::new(sin_t, 0.0, -cos_t)
+    Some(DVec3::new(sin_t, 0.0, -cos_t))
 }
 
 /// The sums of `photons` walks from `start` in channel `ch`, tallied in the bins `edges`;
@@ -289,8 +293,12 @@ impl EntryDrift {
                 let seed = splitmix64(
                     SEED ^ splitmix64(((ch * nodes + j) as u64) << 32 | k).wrapping_add(ch as u64),
                 );
-                let start = refracted(COS_NODES[j], medium.eta());
-                run_chunk(medium, ch, radius, start, &all_edges[ch], n, seed, false)
+                match refracted(COS_NODES[j], medium.eta()) {
+                    Some(start) => {
+                        run_chunk(medium, ch, radius, start, &all_edges[ch], n, seed, false)
+                    }
+                    None => Sums::new(),
+                }
             })
             .collect();
         let mut totals: Vec<Sums> = (0..3 * nodes).map(|_| Sums::new()).collect();

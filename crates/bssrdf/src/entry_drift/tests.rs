@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 /// 0, 1, …, tallied in channel 0's bins; `single`: one collision only.
 fn sums(medium: &Medium, radius: Option<f64>, cos_i: f64, photons: u64, single: bool) -> Sums {
     let e = edges(medium, 0, radius);
-    let start = refracted(cos_i, medium.eta());
+    let start = refracted(cos_i, medium.eta()).unwrap();
     let chunks = photons.div_ceil(CHUNK_PHOTONS);
     let parts: Vec<Sums> = (0..chunks)
         .into_par_iter()
@@ -241,4 +241,63 @@ fn thread_count_does_not_matter_and_bad_radii_are_refused() {
         let e = EntryDrift::new(&medium, Some(bad)).unwrap_err().to_string();
         assert!(e.contains("radius"), "{e}");
     }
+}
+
+/// The chord bins, by hand: skin1's red (reduced mean free path 1/(0.032 + 0.74) mm, diffusion
+/// length 1/√(3 σ_a σ'_t)) from a twentieth of the mean free path to 16 diffusion lengths in
+/// the half-space, to a ball's diameter where that is shorter, with the first edge at most a
+/// hundredth of the last; a medium without absorption (no diffusion length) reaches 1 000 mean
+/// free paths; the bins' widths grow by one ratio.
+#[test]
+fn the_bins_reach_sixteen_diffusion_lengths_or_the_diameter() {
+    let skin1 = Medium::preset("skin1").unwrap();
+    let (sa, ss) = (skin1.sigma_a()[0], skin1.sigma_s()[0]);
+    let mfp = 1.0 / (sa + ss);
+    let reach = 16.0 / (3.0 * sa * (sa + ss)).sqrt();
+    let check = |e: &[f64], first: f64, last: f64| {
+        assert_eq!(e.len(), BINS + 1);
+        assert_eq!(e[0], 0.0);
+        assert!(
+            (e[1] / first - 1.0).abs() < 1e-12,
+            "first edge {} vs {first}",
+            e[1]
+        );
+        assert!(
+            (e[BINS] / last - 1.0).abs() < 1e-12,
+            "last edge {} vs {last}",
+            e[BINS]
+        );
+        let ratio = e[2] / e[1];
+        for b in 2..BINS {
+            assert!((e[b + 1] / e[b] / ratio - 1.0).abs() < 1e-9, "bin {b}");
+        }
+    };
+    check(&edges(&skin1, 0, None), 0.05 * mfp, reach);
+    check(&edges(&skin1, 0, Some(100.0)), 0.05 * mfp, reach);
+    check(&edges(&skin1, 0, Some(5.0)), 0.05 * mfp, 10.0);
+    check(&edges(&skin1, 0, Some(0.5)), 0.01, 1.0);
+    let lossless = Medium::new([0.0; 3], [2.0; 3], 0.0, 1.3).unwrap();
+    check(&edges(&lossless, 0, None), 0.05 * 0.5, 500.0);
+}
+
+/// Light refracted from outside cosine μ through η leaves along +x with sin θ_t = sin θ_i / η
+/// (Snell), straight down at normal incidence; into a medium less dense than outside (η < 1)
+/// none enters beyond the critical angle, so a walk there drifts nothing, and finishes (a beam
+/// along the surface of a ball would glance off it for ever).
+#[test]
+fn the_beam_enters_refracted() {
+    for (cos_i, eta) in [(1.0, 1.3), (0.5, 1.3), (0.05, 1.5), (0.3, 1.0), (0.9, 0.8)] {
+        let d = refracted(cos_i, eta).unwrap();
+        let sin_i = (1.0f64 - cos_i * cos_i).sqrt();
+        assert!((d.x - sin_i / eta).abs() < 1e-12, "{d:?}");
+        assert_eq!(d.y, 0.0);
+        assert!((d.length() - 1.0).abs() < 1e-12 && d.z < 0.0, "{d:?}");
+    }
+    assert_eq!(refracted(0.5, 0.8), None);
+    assert_eq!(refracted(0.0, 1.0), None);
+    let light = Medium::new([0.1; 3], [1.0; 3], 0.0, 0.8).unwrap();
+    let d = EntryDrift::with_photons(&light, Some(3.0), 1 << 12).unwrap();
+    // cos θ_i = 0.5: sin θ_i / η = 1.08, beyond the critical angle.
+    assert_eq!(d.k(0, 0.5, 0.5), 0.0);
+    assert!(d.k(0, 0.5, 0.8) > 0.0);
 }
