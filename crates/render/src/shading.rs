@@ -808,7 +808,7 @@ mod tests {
     fn drift_moves_light_ahead_of_its_direction() {
         let medium = Medium::preset("skin1").unwrap();
         let plain = shading(ModelKind::McTable, medium.clone(), 1.0);
-        let mut t = Translucent {
+        let t = Translucent {
             model: ModelKind::McTable,
             medium,
             units_per_mm: 1.0,
@@ -818,7 +818,6 @@ mod tests {
             drift: true,
         };
         let drifting = TranslucentShading::new("test", &t);
-        t.drift = false;
         assert!(drifting.drift.is_some() && plain.drift.is_none());
         let theta = 70f64.to_radians();
         // From the point towards the light: the light travels along +x, downwards.
