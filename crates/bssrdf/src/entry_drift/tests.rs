@@ -3,8 +3,20 @@ use crate::quadrature::integrate;
 use std::f64::consts::PI;
 
 /// The sums of `photons` walks of channel 0 from outside cosine `cos_i`, in chunks seeded
-/// 0, 1, …, tallied in channel 0's bins; `single`: one collision only.
+/// 1000, 1001, …, tallied in channel 0's bins; `single`: one collision only.
 fn sums(medium: &Medium, radius: Option<f64>, cos_i: f64, photons: u64, single: bool) -> Sums {
+    sums_seeded(medium, radius, cos_i, photons, single, 1000)
+}
+
+/// [`sums`] with chunks seeded `seed`, `seed` + 1, ….
+fn sums_seeded(
+    medium: &Medium,
+    radius: Option<f64>,
+    cos_i: f64,
+    photons: u64,
+    single: bool,
+    seed: u64,
+) -> Sums {
     let e = edges(medium, 0, radius);
     let start = refracted(cos_i, medium.eta()).unwrap();
     let chunks = photons.div_ceil(CHUNK_PHOTONS);
@@ -12,7 +24,7 @@ fn sums(medium: &Medium, radius: Option<f64>, cos_i: f64, photons: u64, single: 
         .into_par_iter()
         .map(|k| {
             let n = CHUNK_PHOTONS.min(photons - k * CHUNK_PHOTONS);
-            run_chunk(medium, 0, radius, start, &e, n, 1000 + k, single)
+            run_chunk(medium, 0, radius, start, &e, n, seed + k, single)
         })
         .collect();
     let mut total = Sums::new();
@@ -300,4 +312,38 @@ fn the_beam_enters_refracted() {
     // cos θ_i = 0.5: sin θ_i / η = 1.08, beyond the critical angle.
     assert_eq!(d.k(0, 0.5, 0.5), 0.0);
     assert!(d.k(0, 0.5, 0.8) > 0.0);
+}
+
+/// The standard errors are honest: over 12 independent runs, k's spread in each bin holding
+/// light is its reported standard error on average (the ratio within 0.75–1.33, averaged
+/// over the bins), so the shrinking towards 0 and the tests' tolerances rest on a true noise.
+#[test]
+fn standard_errors_match_the_spread_of_independent_runs() {
+    let medium = Medium::preset("skin1").unwrap();
+    let photons = 1 << 13;
+    let runs: Vec<(Vec<f64>, Vec<f64>)> = (0..12)
+        .map(|i| {
+            raw_k(
+                &sums_seeded(&medium, None, 0.5, photons, false, 1 << (20 + i)),
+                photons,
+            )
+        })
+        .collect();
+    let mut ratios = Vec::new();
+    for b in 0..BINS {
+        let ks: Vec<f64> = runs.iter().map(|r| r.0[b]).collect();
+        let se: f64 = runs.iter().map(|r| r.1[b]).sum::<f64>() / runs.len() as f64;
+        if se <= 0.0 || se > 0.3 || ks.iter().any(|k| *k == 0.0) {
+            continue;
+        }
+        let mean = ks.iter().sum::<f64>() / ks.len() as f64;
+        let var = ks.iter().map(|k| (k - mean).powi(2)).sum::<f64>() / (ks.len() - 1) as f64;
+        ratios.push(var.sqrt() / se);
+    }
+    assert!(ratios.len() >= 10, "{} bins", ratios.len());
+    let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+    assert!(
+        (0.75..1.33).contains(&mean),
+        "spread / standard error {mean:.3} ({ratios:?})"
+    );
 }
