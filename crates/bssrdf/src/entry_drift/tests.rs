@@ -333,7 +333,7 @@ fn standard_errors_match_the_spread_of_independent_runs() {
     for b in 0..BINS {
         let ks: Vec<f64> = runs.iter().map(|r| r.0[b]).collect();
         let se: f64 = runs.iter().map(|r| r.1[b]).sum::<f64>() / runs.len() as f64;
-        if se <= 0.0 || se > 0.3 || ks.iter().any(|k| *k == 0.0) {
+        if se <= 0.0 || se > 0.3 || ks.contains(&0.0) {
             continue;
         }
         let mean = ks.iter().sum::<f64>() / ks.len() as f64;
