@@ -347,3 +347,66 @@ fn standard_errors_match_the_spread_of_independent_runs() {
         "spread / standard error {mean:.3} ({ratios:?})"
     );
 }
+
+/// The shrinking by hand: k(1 − s²/k²) where |k| > s, else 0; clamped to [−1, 1]; 0 for
+/// what is not a number.
+#[test]
+fn shrink_by_hand() {
+    assert!((shrink(0.5, 0.1) - 0.48).abs() < 1e-15);
+    assert!((shrink(-0.5, 0.1) + 0.48).abs() < 1e-15);
+    assert!((shrink(0.3, 0.2) - 0.3 * (1.0 - 0.04 / 0.09)).abs() < 1e-15);
+    assert_eq!(shrink(0.05, 0.1), 0.0);
+    assert_eq!(shrink(0.1, 0.1), 0.0);
+    assert_eq!(shrink(3.0, 0.1), 1.0);
+    assert_eq!(shrink(-3.0, 0.1), -1.0);
+    assert_eq!(shrink(0.4, 0.0), 0.4);
+    assert_eq!(shrink(f64::NAN, 0.1), 0.0);
+}
+
+/// Between incidence nodes k is linear in cos θ_i (the mean of two neighbouring nodes' values
+/// half-way between them), below the first node it is the first node's, and from the last
+/// node it falls linearly to 0 at normal incidence; the accessors give the bins' centres and
+/// a positive standard error where light arrived.
+#[test]
+fn k_between_nodes_and_the_accessors() {
+    let medium = Medium::preset("skin1").unwrap();
+    let d = EntryDrift::with_photons(&medium, Some(6.0), 1 << 13).unwrap();
+    let last = COS_NODES.len() - 1;
+    for ch in 0..3 {
+        for r in [0.2, 1.0, 4.0] {
+            let at = d.at(r);
+            for j in 0..last {
+                let (a, b) = (at.ks(COS_NODES[j])[ch], at.ks(COS_NODES[j + 1])[ch]);
+                let mid = at.ks(0.5 * (COS_NODES[j] + COS_NODES[j + 1]))[ch];
+                assert!((mid - 0.5 * (a + b)).abs() < 1e-12, "{ch} {r} node {j}");
+            }
+            assert_eq!(at.ks(0.0)[ch], at.ks(COS_NODES[0])[ch]);
+            let top = at.ks(COS_NODES[last])[ch];
+            let half = at.ks(0.5 * (1.0 + COS_NODES[last]))[ch];
+            assert!((half - 0.5 * top).abs() < 1e-12);
+            assert_eq!(d.k(ch, r, 0.3), at.ks(0.3)[ch]);
+        }
+        let e = edges(&medium, ch, Some(6.0));
+        let c = d.centres(ch);
+        assert_eq!(c.len(), BINS);
+        for b in 0..BINS {
+            assert!((c[b] - 0.5 * (e[b] + e[b + 1])).abs() < 1e-12 * e[BINS]);
+        }
+        // Light reaches the first bins at every node: their errors are positive and small.
+        for j in 0..COS_NODES.len() {
+            let se = d.k_se(ch, j, 2);
+            assert!(se > 0.0 && se < 0.5, "channel {ch}, node {j}: {se}");
+        }
+    }
+}
+
+/// A medium that absorbs far more than it scatters has a diffusion length under ten mean free
+/// paths: its bins still reach ten mean free paths.
+#[test]
+fn strong_absorbers_reach_ten_mean_free_paths() {
+    let m = Medium::new([10.0; 3], [0.1; 3], 0.0, 1.3).unwrap();
+    let mfp = 1.0 / 10.1;
+    assert!(16.0 / m.sigma_tr(0) < 10.0 * mfp);
+    let e = edges(&m, 0, None);
+    assert!((e[BINS] / (10.0 * mfp) - 1.0).abs() < 1e-12, "{}", e[BINS]);
+}
