@@ -3,7 +3,7 @@
 //! The tests in `tests/tests/` exercise the crates together, the way the tools use them: the
 //! models of `sss-bssrdf` through the profile tables and plots of `sss-render`, and the
 //! Monte Carlo reference through both. The `sss` binary's own end-to-end tests live next to
-//! it in `crates/render/tests/cli.rs` (Cargo only builds a binary for tests of its package).
+//! it in `crates/cli/tests/integration/cli.rs` (Cargo only builds a binary for tests of its package).
 //!
 //! ```text
 //! cargo test -p sss-tests --release

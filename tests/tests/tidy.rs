@@ -233,3 +233,150 @@ fn the_path_scan_sees_groups_and_chains_but_not_comments() {
     }
     assert!(!names.iter().any(|n| n == "dual_tree"), "{names:?}");
 }
+
+/// The top-level entries a repository path in the docs starts with.
+const TOP: [&str; 8] = [
+    "crates/", "docs/", "scenes/", "tests/", "xtask/", "fuzz/", ".ci/", ".cargo/",
+];
+
+/// The repository paths `text` names: text in backticks or a Markdown link's target that
+/// starts with a top-level entry ([`TOP`]), with `{a,b}` groups expanded (an element `…` is
+/// left out), trailing punctuation and `:line` suffixes cut, and placeholders (`<…>`, `*`,
+/// `…`, a segment such as `TARGET`), generated output (`target/`) and fenced code blocks
+/// (commands and sample output) left out.
+fn named_paths(text: &str) -> Vec<String> {
+    let mut fenced = false;
+    let prose: Vec<&str> = text
+        .lines()
+        .filter(|l| {
+            if l.trim_start().starts_with("```") {
+                fenced = !fenced;
+                return false;
+            }
+            !fenced
+        })
+        .collect();
+    let text = prose.join("\n");
+    let text = text.as_str();
+    let mut candidates: Vec<&str> = Vec::new();
+    for (i, part) in text.split('`').enumerate() {
+        if i % 2 == 1 {
+            candidates.push(part);
+        }
+    }
+    let mut rest = text;
+    while let Some(k) = rest.find("](") {
+        rest = &rest[k + 2..];
+        if let Some(end) = rest.find(')') {
+            candidates.push(&rest[..end]);
+        }
+    }
+    let mut out = Vec::new();
+    for c in candidates {
+        let c = c.trim().split(['#', ' ']).next().unwrap_or("");
+        let c = c.trim_end_matches([',', '.', ';', ':']);
+        let placeholder = c
+            .split(['/', '.'])
+            .any(|seg| ["TARGET", "DIR", "NAME", "FILE", "CRATE"].contains(&seg));
+        if !TOP.iter().any(|t| c.starts_with(t)) || c.contains(['<', '*', '$']) || placeholder {
+            continue;
+        }
+        // `path:line` or `path:line:col`.
+        let c = match c.split_once(':') {
+            Some((p, tail)) if tail.chars().all(|x| x.is_ascii_digit() || x == ':') => p,
+            _ => c,
+        };
+        for p in expand_braces(c) {
+            if !p.contains('…') && !p.contains("...") {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+/// `a/{b,c}.rs` as `a/b.rs` and `a/c.rs` (one group; none: the path itself).
+fn expand_braces(p: &str) -> Vec<String> {
+    match (p.find('{'), p.find('}')) {
+        (Some(a), Some(b)) if a < b => p[a + 1..b]
+            .split(',')
+            .flat_map(|x| expand_braces(&format!("{}{}{}", &p[..a], x.trim(), &p[b + 1..])))
+            .collect(),
+        _ => vec![p.to_string()],
+    }
+}
+
+/// Every `.md` file under `dir`, recursively.
+fn markdown_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            markdown_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "md") {
+            out.push(p);
+        }
+    }
+}
+
+/// The README, ARCHITECTURE.md, every page under `docs/` and `scenes/`, and every crate's
+/// documentation (the `//!` lines of its `src/lib.rs`) name only repository paths that exist:
+/// a file moved without its docs fails here, naming the document and the path.
+#[test]
+fn docs_name_only_paths_that_exist() {
+    let root = root();
+    let mut docs = vec![root.join("README.md"), root.join("ARCHITECTURE.md")];
+    markdown_files(&root.join("docs"), &mut docs);
+    markdown_files(&root.join("scenes"), &mut docs);
+    let mut crate_docs = Vec::new();
+    for dir in ["crates", "tests", "xtask"] {
+        rust_files(&root.join(dir), &mut crate_docs);
+    }
+    crate_docs.retain(|p| p.ends_with("src/lib.rs"));
+    let mut missing = Vec::new();
+    for doc in docs.iter().chain(&crate_docs) {
+        let text = std::fs::read_to_string(doc).unwrap();
+        let text: String = if doc.extension().is_some_and(|x| x == "rs") {
+            text.lines()
+                .filter_map(|l| l.trim_start().strip_prefix("//!"))
+                .collect::<Vec<_>>()
+                .join("\n")
+        } else {
+            text
+        };
+        for p in named_paths(&text) {
+            if !root.join(&p).exists() {
+                missing.push(format!(
+                    "{}: `{p}`",
+                    doc.strip_prefix(&root).unwrap_or(doc).display()
+                ));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "{} paths named in the docs do not exist:\n{}",
+        missing.len(),
+        missing.join("\n")
+    );
+}
+
+/// The path scan by hand: backticks and links, groups, line suffixes, placeholders.
+#[test]
+fn the_doc_path_scan_reads_backticks_links_and_groups() {
+    let text = "See `crates/a/src/{b,c}.rs`, [d](docs/e.md#part) and `crates/f.rs:12:3`; \
+                not `target/x`, `crates/<crate>/g.rs`, `crates/{h,…}.rs`, `fuzz/TARGET.dict` \
+                or `src/i.rs`.\n```\nsss render scenes/nothing.toml\n```\n";
+    assert_eq!(
+        named_paths(text),
+        [
+            "crates/a/src/b.rs",
+            "crates/a/src/c.rs",
+            "crates/f.rs",
+            "crates/h.rs",
+            "docs/e.md"
+        ]
+    );
+}
