@@ -349,7 +349,8 @@ fn registry_errors_name_the_method_and_option() {
     assert!(e.contains("--spacing") && e.contains("`x`"), "{e}");
 }
 
-/// A method may be given as a plain value too: the registry's default matches the type's.
+/// A method may be given as a plain value too: the registry's default matches the type's, for
+/// every method.
 #[test]
 fn registry_defaults_match_the_settings_types() {
     use sss_render::integrators::exact::Exact;
@@ -362,5 +363,20 @@ fn registry_defaults_match_the_settings_types() {
     use sss_render::integrators::{eelc::Eelc, mdlc::Mdlc};
     assert_eq!(Mdlc::from_options(&d).unwrap(), Mdlc::default());
     assert_eq!(Eelc::from_options(&d).unwrap(), Eelc::default());
+    use sss_render::integrators::{dual_tree::DualTree, dual_tree_fmm::DualTreeFmm};
+    use sss_render::integrators::{single_tree::SingleTree, volpath::VolPath};
+    assert_eq!(SingleTree::from_options(&d).unwrap(), SingleTree::default());
+    assert_eq!(DualTree::from_options(&d).unwrap(), DualTree::default());
+    assert_eq!(
+        DualTreeFmm::from_options(&d).unwrap(),
+        DualTreeFmm::default()
+    );
+    assert_eq!(VolPath::from_options(&d).unwrap(), VolPath::default());
+    use sss_render::integrators::{manylight::ManyLight, sparse_manylight::SparseManyLight};
+    assert_eq!(ManyLight::from_options(&d).unwrap(), ManyLight::default());
+    assert_eq!(
+        SparseManyLight::from_options(&d).unwrap(),
+        SparseManyLight::default()
+    );
     let _: &dyn Integrator = &Exact::default();
 }
