@@ -380,3 +380,93 @@ fn the_doc_path_scan_reads_backticks_links_and_groups() {
         ]
     );
 }
+
+/// The workspace crates a manifest depends on (its `[dependencies]` and `[dev-dependencies]`
+/// keys named `sss-…`, less the build-only `sss-workspace-hack`), without the prefix.
+fn workspace_dependencies(manifest: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut in_deps = false;
+    for line in manifest.lines() {
+        let l = line.trim();
+        if l.starts_with('[') {
+            in_deps = l == "[dependencies]" || l == "[dev-dependencies]";
+            continue;
+        }
+        if !in_deps {
+            continue;
+        }
+        let key = l.split(['=', '.', ' ']).next().unwrap_or("");
+        if let Some(name) = key.strip_prefix("sss-")
+            && name != "workspace-hack"
+            && !out.iter().any(|o| o == name)
+        {
+            out.push(name.to_string());
+        }
+    }
+    out
+}
+
+/// ARCHITECTURE.md's crate table says, in its last column, which workspace crates each crate
+/// depends on: for every row, the workspace crates named there are exactly those its
+/// `Cargo.toml` names (dependencies and dev-dependencies), so the table cannot drift from the
+/// manifests.
+#[test]
+fn the_architecture_table_names_each_crates_dependencies() {
+    let root = root();
+    let text = std::fs::read_to_string(root.join("ARCHITECTURE.md")).unwrap();
+    let crates: Vec<String> = std::fs::read_dir(root.join("crates"))
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().join("Cargo.toml").exists())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    let mut rows = 0;
+    let mut wrong = Vec::new();
+    for line in text.lines().filter(|l| l.starts_with("| `")) {
+        let cells: Vec<&str> = line.split(" | ").collect();
+        let folder = cells[0].trim_start_matches("| ").trim_matches('`');
+        let manifest = root.join(folder).join("Cargo.toml");
+        let Ok(manifest) = std::fs::read_to_string(&manifest) else {
+            continue;
+        };
+        rows += 1;
+        let last = cells
+            .last()
+            .unwrap()
+            .trim_end_matches(" |")
+            .trim_end_matches('|');
+        let named: Vec<String> = last
+            .split([',', ';'])
+            .map(|w| w.split_whitespace().next().unwrap_or("").to_string())
+            .filter(|w| crates.contains(w) && w != "workspace-hack")
+            .collect();
+        let mut actual = workspace_dependencies(&manifest);
+        actual.sort();
+        let mut named_sorted = named.clone();
+        named_sorted.sort();
+        named_sorted.dedup();
+        if actual != named_sorted {
+            wrong.push(format!(
+                "{folder}: the table names {named_sorted:?}, Cargo.toml {actual:?}"
+            ));
+        }
+    }
+    assert!(rows >= 15, "only {rows} rows of the crate table read");
+    assert!(
+        wrong.is_empty(),
+        "ARCHITECTURE.md's dependencies:\n{}",
+        wrong.join("\n")
+    );
+}
+
+/// The manifest scan by hand: both dependency tables, dotted and inline keys, the build-only
+/// hack and other sections left out, each crate once.
+#[test]
+fn the_manifest_scan_reads_both_dependency_tables() {
+    let manifest = "[package]\nname = \"sss-x\"\n\n[dependencies]\nsss-util.workspace = true\n\
+                    sss-gpu = { workspace = true, optional = true }\nglam.workspace = true\n\
+                    sss-workspace-hack.workspace = true\n\n[dev-dependencies]\n\
+                    sss-peers.workspace = true\nsss-util.workspace = true\n\n\
+                    [features]\nsss-render = []\n";
+    assert_eq!(workspace_dependencies(manifest), ["util", "gpu", "peers"]);
+}
