@@ -10,19 +10,24 @@ fn root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Every `.rs` file under `dir`, recursively.
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+/// Every file under `dir` whose extension is `ext`, recursively.
+fn files_with_extension(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
     for e in entries.flatten() {
         let p = e.path();
         if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
+            files_with_extension(&p, ext, out);
+        } else if p.extension().is_some_and(|x| x == ext) {
             out.push(p);
         }
     }
+}
+
+/// Every `.rs` file under `dir`, recursively.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    files_with_extension(dir, "rs", out);
 }
 
 /// Whether `text` uses the `unsafe` keyword outside comments (a block, fn, impl or trait).
@@ -306,21 +311,6 @@ fn expand_braces(p: &str) -> Vec<String> {
     }
 }
 
-/// Every `.md` file under `dir`, recursively.
-fn markdown_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            markdown_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "md") {
-            out.push(p);
-        }
-    }
-}
-
 /// The README, ARCHITECTURE.md, every page under `docs/` and `scenes/`, and every crate's
 /// documentation (the `//!` lines of its `src/lib.rs`) name only repository paths that exist:
 /// a file moved without its docs fails here, naming the document and the path.
@@ -328,8 +318,8 @@ fn markdown_files(dir: &Path, out: &mut Vec<PathBuf>) {
 fn docs_name_only_paths_that_exist() {
     let root = root();
     let mut docs = vec![root.join("README.md"), root.join("ARCHITECTURE.md")];
-    markdown_files(&root.join("docs"), &mut docs);
-    markdown_files(&root.join("scenes"), &mut docs);
+    files_with_extension(&root.join("docs"), "md", &mut docs);
+    files_with_extension(&root.join("scenes"), "md", &mut docs);
     let mut crate_docs = Vec::new();
     for dir in ["crates", "tests", "xtask"] {
         rust_files(&root.join(dir), &mut crate_docs);

@@ -645,7 +645,9 @@ pub(crate) fn condensed_escapes(
 /// in the half-space (`sphere` `None`) or in the ball of radius `sphere` under the entry point
 /// (centred at (0, 0, −R)), starting at the origin heading along `start` (unit, d_z < 0) with
 /// weight 1. Calls `escape(p, weight, collisions)` for each weight leaving at the point `p`
-/// after `collisions` ≥ 1 collisions (light crossing without a collision is not diffuse). Used by
+/// after `collisions` ≥ 1 collisions (the beam starts into the medium, and the ball's boundary
+/// step tallies nothing before the first collision: light crossing without one is not
+/// diffuse). Used by
 /// [`crate::entry_drift::EntryDrift`].
 pub(crate) fn walk_escapes(
     medium: &Medium,
@@ -662,11 +664,7 @@ pub(crate) fn walk_escapes(
         medium.eta(),
         sphere,
     );
-    trace_photon(&walk, start, rng, &mut |p, _, w, n| {
-        if n > 0 {
-            escape(p, w, n);
-        }
-    });
+    trace_photon(&walk, start, rng, &mut |p, _, w, n| escape(p, w, n));
 }
 
 /// Standard error of the mean of N samples with sums `s`, `s2`.

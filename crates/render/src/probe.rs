@@ -325,21 +325,18 @@ impl Sampler<'_> {
                     out[c] += sv[c] * packet.e_cos[c] * tex[c] * s_area;
                 }
             }
-        } else if shading.drift.is_some() {
-            // Each packet moved by the drift ([`TranslucentShading::entering_towards`]).
-            for packet in packets.iter_mut() {
-                for c in 0..3 {
-                    packet.e_cos[c] *= tex[c];
-                }
-            }
-            let e = shading.entering_towards(packets, (pi.p, pi.n), (g.p, g.n, g.wo));
-            let rd = shading.rd_scene((pi.p - g.p).length());
-            let w = shading.exit_weights(g.n, g.wo);
-            for c in 0..3 {
-                out[c] = rd[c] * e[c] * (w[c] / pdf);
-            }
         } else {
-            let e = shading.weights.entering(packets, pi.n, tex);
+            let e = if shading.drift.is_some() {
+                // Each packet moved by the drift ([`TranslucentShading::entering_towards`]).
+                for packet in packets.iter_mut() {
+                    for c in 0..3 {
+                        packet.e_cos[c] *= tex[c];
+                    }
+                }
+                shading.entering_towards(packets, (pi.p, pi.n), (g.p, g.n, g.wo))
+            } else {
+                shading.weights.entering(packets, pi.n, tex)
+            };
             let rd = shading.rd_scene((pi.p - g.p).length());
             let w = shading.exit_weights(g.n, g.wo);
             for c in 0..3 {

@@ -515,24 +515,25 @@ impl TranslucentShading {
         (xi, ni): (DVec3, DVec3),
         (xo, no, wo): (DVec3, DVec3, DVec3),
     ) -> Rgb {
+        // The drift read at this pair's chord, and the exit's k and azimuth, once per pair.
+        let exit = self.drift.as_ref().map(|drift| {
+            let at = drift.at((xo - xi).length() / self.units_per_mm);
+            (
+                at,
+                at.ks(no.dot(wo).abs()),
+                along_surface_cos(-wo, xi - xo, no),
+            )
+        });
         let mut e = [0.0; 3];
-        let Some(drift) = &self.drift else {
-            for packet in packets {
-                let w = self.weights.entry_weight(ni, packet.dir);
-                for c in 0..3 {
-                    e[c] += w[c] * packet.e_cos[c];
-                }
-            }
-            return e;
-        };
-        let at = drift.at((xo - xi).length() / self.units_per_mm);
-        let cos_phi_o = along_surface_cos(-wo, xi - xo, no);
-        let ko = at.ks(no.dot(wo).abs());
         for packet in packets {
             let w = self.weights.entry_weight(ni, packet.dir);
-            let cos_phi_i = along_surface_cos(-packet.dir, xo - xi, ni);
-            let ki = at.ks(ni.dot(packet.dir).abs());
-            let m = DriftAt::combine(ki, cos_phi_i, ko, cos_phi_o);
+            let m = match &exit {
+                Some((at, ko, cos_phi_o)) => {
+                    let cos_phi_i = along_surface_cos(-packet.dir, xo - xi, ni);
+                    DriftAt::combine(at.ks(ni.dot(packet.dir).abs()), cos_phi_i, *ko, *cos_phi_o)
+                }
+                None => [1.0; 3],
+            };
             for c in 0..3 {
                 e[c] += w[c] * m[c] * packet.e_cos[c];
             }

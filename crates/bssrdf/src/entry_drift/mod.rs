@@ -81,18 +81,19 @@ pub const COS_NODES: [f64; 6] = [0.05, 0.2, 0.35, 0.5, 0.65, 0.8];
 /// The walks' seed.
 const SEED: u64 = 0x0044_5249_4654;
 
-/// k(r) of one channel at one incidence: bin centres (mm), k and its standard error.
+/// k(r) of one channel: its bins' centres (mm), and per incidence node k and its standard
+/// error per bin.
 #[derive(Clone, Debug, Default)]
-struct Row {
+struct Channel {
     centres: Vec<f64>,
-    k: Vec<f64>,
-    se: Vec<f64>,
+    k: Vec<Vec<f64>>,
+    se: Vec<Vec<f64>>,
 }
 
-impl Row {
-    /// k at chord `r`: linear between bin centres, the end bins' values beyond them.
-    fn at(&self, r: f64) -> f64 {
-        between_centres(&self.centres, &self.k, r)
+impl Channel {
+    /// k at node `j` and chord `r`: linear between bin centres, the end bins' values beyond.
+    fn at(&self, j: usize, r: f64) -> f64 {
+        between_centres(&self.centres, &self.k[j], r)
     }
 }
 
@@ -101,8 +102,8 @@ impl Row {
 #[derive(Clone, Debug)]
 pub struct EntryDrift {
     radius: Option<f64>,
-    /// Per channel, per node of [`COS_NODES`].
-    rows: [Vec<Row>; 3],
+    /// Per channel (each with a row per node of [`COS_NODES`]).
+    channels: [Channel; 3],
 }
 
 /// The chord bins' edges of channel `ch` (mm): geometric from a twentieth of a reduced mean
@@ -305,22 +306,24 @@ impl EntryDrift {
         for (&(ch, j, _), s) in items.iter().zip(&results) {
             totals[ch * nodes + j].add(s);
         }
-        let rows: [Vec<Row>; 3] = std::array::from_fn(|ch| {
-            let e = &all_edges[ch];
-            let centres: Vec<f64> = e.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
-            (0..nodes)
-                .map(|j| {
-                    let (raw, se) = raw_k(&totals[ch * nodes + j], photons);
-                    let k = raw.iter().zip(&se).map(|(&k, &e)| shrink(k, e)).collect();
-                    Row {
-                        centres: centres.clone(),
-                        k,
-                        se,
-                    }
-                })
-                .collect()
+        let channels: [Channel; 3] = std::array::from_fn(|ch| {
+            let mut channel = Channel {
+                centres: all_edges[ch]
+                    .windows(2)
+                    .map(|w| 0.5 * (w[0] + w[1]))
+                    .collect(),
+                ..Channel::default()
+            };
+            for j in 0..nodes {
+                let (raw, se) = raw_k(&totals[ch * nodes + j], photons);
+                channel
+                    .k
+                    .push(raw.iter().zip(&se).map(|(&k, &e)| shrink(k, e)).collect());
+                channel.se.push(se);
+            }
+            channel
         });
-        Ok(EntryDrift { radius, rows })
+        Ok(EntryDrift { radius, channels })
     }
 
     /// The factors of one medium and ball radius (`None`: the half-space), walked once per
@@ -350,18 +353,18 @@ impl EntryDrift {
     /// incidences of one pair of points.
     pub fn at(&self, r: f64) -> DriftAt {
         DriftAt {
-            nodes: std::array::from_fn(|ch| std::array::from_fn(|j| self.rows[ch][j].at(r))),
+            nodes: std::array::from_fn(|ch| std::array::from_fn(|j| self.channels[ch].at(j, r))),
         }
     }
 
     /// The standard error of channel `ch`'s k in bin `bin` at node `node` (before shrinking).
     pub fn k_se(&self, ch: usize, node: usize, bin: usize) -> f64 {
-        self.rows[ch][node].se[bin]
+        self.channels[ch].se[node][bin]
     }
 
     /// The bins' centres of channel `ch` (mm).
     pub fn centres(&self, ch: usize) -> &[f64] {
-        &self.rows[ch][0].centres
+        &self.channels[ch].centres
     }
 
     /// 1 + k(r, θ_i) cos φ_i + k(r, θ_o) cos φ_o per channel (both k divided by

@@ -259,8 +259,7 @@ pub(crate) fn check_radial(frame: &Frame<'_>, method: &str) -> Result<(), Error>
     for &o in &frame.visible {
         if let Some(sh) = frame.shading_of(o) {
             sh.radial(method)?;
-            sh.no_drift(method)?;
         }
     }
-    Ok(())
+    check_no_drift(frame, method)
 }

@@ -146,31 +146,24 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
         }
         return sum;
     }
-    if shading.drift.is_some() {
-        // Each sample's packets, each moved by the drift towards g
-        // ([`TranslucentShading::entering_towards`]).
-        for (i, s) in samples.samples.iter().enumerate() {
-            let rd = shading.rd_sample_scene((s.position - g.p).length(), s.area);
-            let e = shading.entering_towards(
-                samples.incident_of(i),
-                (s.position, s.normal),
-                (g.p, g.n, g.wo),
-            );
-            for c in 0..3 {
-                sum[c] += rd[c] * e[c] * s.area;
-            }
-        }
-        let mut out = [0.0; 3];
-        add_weighted(&mut out, sum, shading.exit_weights(g.n, g.wo));
-        return out;
-    }
+    // A drifting material's irradiance depends on the shading point: each sample's packets,
+    // each moved by the drift towards g ([`TranslucentShading::entering_towards`]).
+    let drift = shading.drift.is_some();
     shading.add_point_sum(
         &mut sum,
         g.p,
-        samples
-            .samples
-            .iter()
-            .map(|s| (s.position, s.area, s.irradiance)),
+        samples.samples.iter().enumerate().map(|(i, s)| {
+            let e = if drift {
+                shading.entering_towards(
+                    samples.incident_of(i),
+                    (s.position, s.normal),
+                    (g.p, g.n, g.wo),
+                )
+            } else {
+                s.irradiance
+            };
+            (s.position, s.area, e)
+        }),
     );
     let mut out = [0.0; 3];
     add_weighted(&mut out, sum, shading.exit_weights(g.n, g.wo));

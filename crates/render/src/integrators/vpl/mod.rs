@@ -118,7 +118,6 @@ pub(crate) fn object_data(
         };
         sh.radial(method)?;
         sh.scalar_weights(method)?;
-        sh.no_drift(method)?;
         if sh.texture.is_some() {
             return Err(Error::Input(format!(
                 "material `{}`: method {method} does not support pre-scatter textures (the \
