@@ -1,20 +1,19 @@
 //! Cross-crate tests: the models of `sss-bssrdf` through the profile and plot code of
 //! `sss-render`.
 
+use sss_bssrdf::MediumSpec;
 use sss_bssrdf::monte_carlo::{self, BinSpacing, McConfig};
 use sss_bssrdf::presets::PRESETS;
+use sss_bssrdf::profile_rows::{ProfileModel, ProfileRequest, compute};
 use sss_bssrdf::{Medium, ModelKind};
-use sss_cli::profile_table::{MediumSpec, ProfileModel, ProfileRequest, compute};
 use std::path::PathBuf;
 
-const MODELS: [ProfileModel; 6] = [
-    ProfileModel::StandardDipole,
-    ProfileModel::BetterDipole,
-    ProfileModel::DirectionalDipole,
-    ProfileModel::Pbd,
-    ProfileModel::Burley,
-    ProfileModel::McTable,
-];
+/// The analytic models (every profile model but the Monte Carlo walk), in `ModelKind` order.
+fn models() -> impl Iterator<Item = ProfileModel> {
+    ProfileModel::ALL
+        .into_iter()
+        .filter(|m| *m != ProfileModel::MonteCarlo)
+}
 
 fn request(model: ProfileModel, preset: &str, r_max: f64, steps: usize) -> ProfileRequest {
     ProfileRequest {
@@ -25,7 +24,7 @@ fn request(model: ProfileModel, preset: &str, r_max: f64, steps: usize) -> Profi
 
 #[test]
 fn every_model_gives_finite_profiles_for_every_preset() {
-    for model in MODELS {
+    for model in models() {
         for preset in &PRESETS {
             for log in [false, true] {
                 let req = ProfileRequest {
@@ -60,7 +59,8 @@ fn every_model_gives_finite_profiles_for_every_preset() {
 
 #[test]
 fn profile_model_names_are_the_library_names() {
-    for (m, k) in MODELS.iter().zip(ModelKind::ALL) {
+    assert_eq!(models().count(), ModelKind::ALL.len());
+    for (m, k) in models().zip(ModelKind::ALL) {
         assert_eq!(m.kind(), Some(k));
         assert_eq!(m.name().parse::<ModelKind>().unwrap(), k);
     }
@@ -99,10 +99,10 @@ fn monte_carlo_table_is_the_library_simulation() {
 fn every_model_plots() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("profiles-plot");
     std::fs::create_dir_all(&dir).unwrap();
-    for model in MODELS {
+    for model in models() {
         let t = compute(&request(model, "potato", 20.0, 50), &|_| {}).unwrap();
         let path = dir.join(format!("{}.svg", model.name()));
-        t.plot(&path, false).unwrap();
+        sss_cli::commands::profile::plot(&t, &path, false).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.contains("<svg") && text.contains("green"));
     }

@@ -449,6 +449,41 @@ fn the_architecture_table_names_each_crates_dependencies() {
     );
 }
 
+/// Only the binary depends on the libraries: no crate depends on `sss-cli` but `xtask` (its
+/// clap definitions make the generated reference and the argument fuzzer) and this test crate
+/// (as a dev-dependency, to test the CLI's own code); what a command does lives in the library
+/// that owns the idea.
+#[test]
+fn nothing_but_xtask_and_tests_depends_on_the_binary_crate() {
+    let root = root();
+    let mut manifests: Vec<PathBuf> = std::fs::read_dir(root.join("crates"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path().join("Cargo.toml"))
+        .filter(|p| p.exists())
+        .collect();
+    manifests.push(root.join("xtask/Cargo.toml"));
+    manifests.push(root.join("tests/Cargo.toml"));
+    assert!(manifests.len() >= 15, "{manifests:?}");
+    let mut users = Vec::new();
+    for path in &manifests {
+        let text = std::fs::read_to_string(path).unwrap();
+        if workspace_dependencies(&text).iter().any(|d| d == "cli") {
+            let folder = path.parent().unwrap().strip_prefix(&root).unwrap();
+            users.push(folder.display().to_string());
+        }
+    }
+    users.sort();
+    assert_eq!(users, ["tests", "xtask"], "crates that depend on sss-cli");
+    // The test crate only as a dev-dependency: its library half does not.
+    let tests = std::fs::read_to_string(root.join("tests/Cargo.toml")).unwrap();
+    let deps = tests.split("[dev-dependencies]").next().unwrap();
+    assert!(
+        !workspace_dependencies(deps).iter().any(|d| d == "cli"),
+        "tests/Cargo.toml: sss-cli outside [dev-dependencies]"
+    );
+}
+
 /// The manifest scan by hand: both dependency tables, dotted and inline keys, the build-only
 /// hack and other sections left out, each crate once.
 #[test]

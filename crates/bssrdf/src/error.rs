@@ -48,6 +48,9 @@ pub enum BssrdfError {
     },
     /// Any other invalid argument, with an explanation.
     InvalidArgument(String),
+    /// A computation gave a NaN or an infinity where a number was due (a bug, reported
+    /// instead of printed); the message says what.
+    NonFinite(String),
 }
 
 impl fmt::Display for BssrdfError {
@@ -98,7 +101,7 @@ impl fmt::Display for BssrdfError {
                 f,
                 "diffuse reflectance {requested} in channel {channel} is out of reach of the {model} model for any albedo (it reaches at most {max:.6})"
             ),
-            BssrdfError::InvalidArgument(msg) => f.write_str(msg),
+            BssrdfError::InvalidArgument(msg) | BssrdfError::NonFinite(msg) => f.write_str(msg),
         }
     }
 }

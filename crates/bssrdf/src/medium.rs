@@ -182,6 +182,56 @@ impl Medium {
     }
 }
 
+/// Where a medium comes from, as a command or a binding names it: a measured preset by name
+/// or explicit coefficients; [`MediumSpec::medium`] validates it into a [`Medium`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum MediumSpec {
+    /// A measured material of Jensen et al. 2001 by name (g = 0, σ_s = σ'_s).
+    Preset(String),
+    /// Explicit coefficients (1/mm) and anisotropy.
+    Coefficients {
+        /// Absorption σ_a per channel.
+        sigma_a: Rgb,
+        /// Scattering σ_s per channel.
+        sigma_s: Rgb,
+        /// Henyey-Greenstein anisotropy.
+        g: f64,
+    },
+}
+
+impl MediumSpec {
+    /// The validated medium, with `eta` if given (default [`crate::presets::PRESET_ETA`]).
+    pub fn medium(&self, eta: Option<f64>) -> Result<Medium, BssrdfError> {
+        let eta = eta.unwrap_or(crate::presets::PRESET_ETA);
+        match self {
+            MediumSpec::Preset(name) => Medium::preset(name)?.with_eta(eta),
+            MediumSpec::Coefficients {
+                sigma_a,
+                sigma_s,
+                g,
+            } => Medium::new(*sigma_a, *sigma_s, *g, eta),
+        }
+    }
+
+    /// A short description of the medium built from it (plot titles): the preset's name or
+    /// the coefficients, and η.
+    pub fn label(&self, medium: &Medium) -> String {
+        match self {
+            MediumSpec::Preset(name) => format!("{name}, eta {}", medium.eta()),
+            MediumSpec::Coefficients {
+                sigma_a,
+                sigma_s,
+                g,
+            } => format!(
+                "sigma_a {:?}, sigma_s {:?}, g {g}, eta {}",
+                sigma_a,
+                sigma_s,
+                medium.eta()
+            ),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

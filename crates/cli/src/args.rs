@@ -1,10 +1,11 @@
 //! Options shared by several subcommands: the medium (`--preset` or coefficients) and
 //! `R,G,B` triples.
 
-use crate::medium_spec::MediumSpec;
+use clap::builder::{PossibleValuesParser, TypedValueParser};
 use clap::{ArgGroup, Args};
-use sss_bssrdf::Rgb;
+use sss_bssrdf::{MediumSpec, Rgb};
 use sss_render::Error;
+use std::str::FromStr;
 
 /// The medium of `sss profile` and `sss kernel`: a preset, or coefficients.
 #[derive(Debug, Args)]
@@ -54,6 +55,17 @@ pub fn model_help(what: &str) -> String {
     format!("{what} (one of: {})", names.join(", "))
 }
 
+/// A value parser that accepts exactly `names` (listed in the help and in the error for any
+/// other word) and parses the word into a `T` (a library type with `FromStr` whose names these
+/// are).
+pub fn names_parser<T>(names: impl IntoIterator<Item = &'static str>) -> impl TypedValueParser
+where
+    T: FromStr + Clone + Send + Sync + 'static,
+    T::Err: std::error::Error + Send + Sync + 'static,
+{
+    PossibleValuesParser::new(names).try_map(|s| s.parse::<T>())
+}
+
 /// Parses `R,G,B` (three numbers separated by commas; spaces allowed).
 pub fn parse_rgb(s: &str) -> Result<Rgb, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
@@ -83,5 +95,25 @@ mod tests {
         assert!(parse_rgb("1,2,3,4").is_err());
         assert!(parse_rgb("1,x,3").is_err());
         assert!(parse_rgb("-1,2,3").is_ok(), "range is checked by Medium");
+    }
+
+    #[test]
+    fn names_parser_accepts_the_names_only() {
+        use clap::Parser;
+        use sss_bssrdf::profile_rows::ProfileModel;
+        #[derive(Parser)]
+        struct T {
+            #[arg(long, value_parser = names_parser::<ProfileModel>(ProfileModel::ALL.map(|m| m.name())))]
+            model: ProfileModel,
+        }
+        for m in ProfileModel::ALL {
+            let t = T::try_parse_from(["t", "--model", m.name()]).unwrap();
+            assert_eq!(t.model, m);
+        }
+        let e = T::try_parse_from(["t", "--model", "pdb"])
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("monte-carlo") && e.contains("pdb"), "{e}");
     }
 }

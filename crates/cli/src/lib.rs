@@ -3,8 +3,11 @@
 //! The argument definitions (clap derive) and [`main`], which the `sss` binary calls; one
 //! module per subcommand under [`commands`]. Every failure ends in a single `error: …` line
 //! on stderr and a non-zero exit code (2 for bad input, 1 for failures while running); nothing
-//! is written to stdout then. The library part also serves `cargo xtask compare`: radial
-//! profile tables ([`profile_table`]), the presets table and progress bars.
+//! is written to stdout then. Each command is a thin layer over the library that owns its idea
+//! (`sss_bssrdf::profile_rows` for `sss profile`, `sss_render::kernel_export` for `sss
+//! kernel`, `sss_scene::load_named` and `sss_render::render` for `sss render`), so a program
+//! that wants what a command does depends on that library, never on this crate; only `xtask`
+//! uses its clap definitions (the generated reference, the argument fuzzer).
 //!
 //! ```
 //! use clap::Parser;
@@ -25,10 +28,8 @@
 
 pub mod args;
 pub mod commands;
-pub mod medium_spec;
 pub mod method_flags;
 pub mod presets_table;
-pub mod profile_table;
 pub mod progress;
 pub mod reference;
 

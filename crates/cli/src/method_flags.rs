@@ -5,6 +5,7 @@
 
 use clap::builder::PossibleValuesParser;
 use clap::{Arg, ArgAction, ArgMatches, Command};
+use sss_render::integrators::options::RENAMED;
 use sss_render::integrators::{METHODS, MethodOptions, OptionKind, OptionSpec};
 use std::marker::PhantomData;
 
@@ -12,6 +13,12 @@ use std::marker::PhantomData;
 pub trait FlagSet {
     /// The options, each once, with the methods that use it.
     fn specs() -> Vec<(OptionSpec, Vec<&'static str>)>;
+
+    /// Old option names still accepted on the command line (hidden from the help) so that the
+    /// method refuses them with a message naming the new one, instead of clap's guess.
+    fn renamed() -> Vec<&'static str> {
+        Vec::new()
+    }
 }
 
 /// Every option of every registered method (`sss render`).
@@ -30,6 +37,10 @@ impl FlagSet for AllMethods {
             }
         }
         out
+    }
+
+    fn renamed() -> Vec<&'static str> {
+        RENAMED.iter().map(|(old, _)| *old).collect()
     }
 }
 
@@ -60,8 +71,8 @@ pub fn method_parser() -> PossibleValuesParser {
 }
 
 /// The declarations of option `name` by the methods `users`, grouped by (help, default): one
-/// group when they agree; several when methods share a name with their own meaning (e.g.
-/// `--eps`, a solid-angle threshold for the trees and a relative error for `manylight`).
+/// group when they agree; several when methods word one quantity their own way (e.g.
+/// `--rel-error`, whose help says how `manylight`, `sparse-manylight` and `mdlc` apply it).
 fn variants(name: &str, users: &[&str]) -> Vec<(OptionSpec, Vec<&'static str>)> {
     let mut out: Vec<(OptionSpec, Vec<&'static str>)> = Vec::new();
     for m in METHODS.iter().filter(|m| users.contains(&m.name)) {
@@ -158,6 +169,11 @@ impl<S: FlagSet> clap::FromArgMatches for MethodFlags<S> {
                 }
             }
         }
+        for old in S::renamed() {
+            if let Some(v) = m.get_one::<String>(old) {
+                self.options.set(old, v);
+            }
+        }
         Ok(())
     }
 }
@@ -166,6 +182,15 @@ impl<S: FlagSet> clap::Args for MethodFlags<S> {
     fn augment_args(mut cmd: Command) -> Command {
         for (spec, users) in S::specs() {
             cmd = cmd.arg(arg(&spec, &users));
+        }
+        for old in S::renamed() {
+            cmd = cmd.arg(
+                Arg::new(old)
+                    .long(old)
+                    .hide(true)
+                    .action(ArgAction::Set)
+                    .allow_hyphen_values(true),
+            );
         }
         cmd
     }
@@ -200,14 +225,15 @@ mod tests {
                 }
             }
         }
-        // --eps means two things: the help names both, with both defaults.
+        // --rel-error is worded three ways: the help names each, with its default.
         let users: Vec<&str> = METHODS
             .iter()
-            .filter(|m| m.options.iter().any(|o| o.name == "eps"))
+            .filter(|m| m.options.iter().any(|o| o.name == "rel-error"))
             .map(|m| m.name)
             .collect();
-        let groups = variants("eps", &users);
-        if groups.len() > 1 {
+        let groups = variants("rel-error", &users);
+        assert!(groups.len() > 1, "{groups:?}");
+        {
             let spec = groups[0].0;
             let help = arg(&spec, &users)
                 .get_help()

@@ -392,7 +392,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
     if let Some(s) = config.shard {
         return shard::run_shard(config, s, &log_line);
     }
-    let bar = sss_cli::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
+    let bar = sss_util::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
     let log = |msg: &str| {
         if bar.is_hidden() {
             eprintln!("{msg}");

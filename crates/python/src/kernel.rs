@@ -6,14 +6,12 @@ use crate::errors::{guard, to_py, value_error};
 use crate::model::Model;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use sss_bssrdf::{ModelKind, make_model};
-use sss_cli::args::MediumArgs;
-use sss_cli::commands::kernel::{KernelArgs, KernelFormat};
-use sss_cli::profile_table::MediumSpec;
+use sss_bssrdf::{MediumSpec, ModelKind, make_model};
 use sss_render::Error;
 use sss_render::integrators::MethodOptions;
 use sss_render::integrators::separable::kernel_settings;
 use sss_render::kernel_choice::{KernelMethod, MaterialKernel, build_kernel, filter_options};
+use sss_render::kernel_export::{KernelFormat, KernelRequest, export};
 use sss_separable::{NO_OBJECT, ScreenInput, convolve2d, screen_space};
 
 /// One tap: offset (mm) and RGB weight.
@@ -41,24 +39,11 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// The arguments of `sss kernel` that describe this kernel, with output `format`.
-    fn args(&self, format: KernelFormat) -> KernelArgs {
-        let (preset, sigma_a, sigma_s, g) = match &self.spec {
-            MediumSpec::Preset(p) => (Some(p.clone()), None, None, None),
-            MediumSpec::Coefficients {
-                sigma_a,
-                sigma_s,
-                g,
-            } => (None, Some(*sigma_a), Some(*sigma_s), Some(*g)),
-        };
-        KernelArgs {
-            medium: MediumArgs {
-                preset,
-                sigma_a,
-                sigma_s,
-                g,
-                eta: Some(self.eta),
-            },
+    /// The request of `sss kernel` that describes this kernel, with output `format`.
+    fn args(&self, format: KernelFormat) -> KernelRequest {
+        KernelRequest {
+            medium: self.spec.clone(),
+            eta: Some(self.eta),
             model: self.kind,
             method: self.method,
             artist_preset: self.artist_preset.clone(),
@@ -157,20 +142,9 @@ impl Kernel {
     /// "glsl", "hlsl", "wgsl" (float4(r, g, b, offset in mm), centre tap first).
     #[pyo3(signature = (format="json"))]
     fn export(&self, py: Python<'_>, format: &str) -> PyResult<String> {
-        let format = match format {
-            "json" => KernelFormat::Json,
-            "csv" => KernelFormat::Csv,
-            "glsl" => KernelFormat::Glsl,
-            "hlsl" => KernelFormat::Hlsl,
-            "wgsl" => KernelFormat::Wgsl,
-            other => {
-                return Err(value_error(format!(
-                    "unknown format `{other}` (one of: json, csv, glsl, hlsl, wgsl)"
-                )));
-            }
-        };
+        let format: KernelFormat = format.parse().map_err(to_py)?;
         let args = self.args(format);
-        py.detach(|| guard(|| sss_cli::commands::kernel::run(&args).map_err(to_py)))
+        py.detach(|| guard(|| export(&args).map_err(to_py)))
     }
 
     fn __repr__(&self) -> String {
@@ -220,7 +194,7 @@ pub fn kernel(
         rank1: false,
     };
     let args = kernel.args(KernelFormat::Csv);
-    let csv = py.detach(|| guard(|| sss_cli::commands::kernel::run(&args).map_err(to_py)))?;
+    let csv = py.detach(|| guard(|| export(&args).map_err(to_py)))?;
     let (terms, rank1) = parse_csv(&csv).map_err(to_py)?;
     kernel.terms = terms;
     kernel.rank1 = rank1;
@@ -292,8 +266,10 @@ pub fn filter<'py>(
             if kobj.uniform {
                 options.set("uniform-taps", "");
             }
-            let medium =
-                sss_cli::profile_table::build_medium(&kobj.spec, Some(kobj.eta)).map_err(to_py)?;
+            let medium = kobj
+                .spec
+                .medium(Some(kobj.eta))
+                .map_err(|e| to_py(e.into()))?;
             (kobj.kind, medium)
         }
         other => {

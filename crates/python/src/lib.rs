@@ -4,8 +4,9 @@
 //! their Monte Carlo reference, the measured presets, the separable kernels and their shader
 //! exports, the screen-space filter on arrays a user already has (e.g. AOVs of another
 //! renderer), scene renders with any registered method, and the image metrics of `sss diff`.
-//! Every function calls the library functions the `sss` command-line tool calls (most through
-//! `sss-cli`'s library), so a value from Python is the value `sss` prints or writes.
+//! Every function calls the library functions the `sss` command-line tool calls (in
+//! `sss-bssrdf`, `sss-separable`, `sss-scene` and `sss-render`; nothing here depends on the
+//! binary crate), so a value from Python is the value `sss` prints or writes.
 //!
 //! Built with maturin as one abi3 wheel for CPython ≥ 3.10:
 //!

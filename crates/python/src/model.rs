@@ -6,10 +6,8 @@ use crate::errors::{guard, to_py, value_error};
 use crate::progress::run_cancellable;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyFloat, PyTuple};
-use sss_bssrdf::{Bssrdf, Medium, ModelKind, Rgb, make_model};
-use sss_cli::profile_table::{
-    MediumSpec, ProfileModel, ProfileRequest, build_medium, check_budget, compute,
-};
+use sss_bssrdf::profile_rows::{ProfileModel, ProfileRequest, check_budget, compute};
+use sss_bssrdf::{Bssrdf, Medium, MediumSpec, ModelKind, Rgb, make_model};
 use sss_render::Error;
 
 /// The medium named by the keyword arguments shared by `Model` and `monte_carlo`: a preset
@@ -131,7 +129,7 @@ impl Model {
         guard(|| {
             let kind: ModelKind = kind.parse().map_err(|e| to_py(Error::Bssrdf(e)))?;
             let spec = medium_spec(preset, sigma_a, sigma_s, g)?;
-            let medium = build_medium(&spec, eta).map_err(to_py)?;
+            let medium = spec.medium(eta).map_err(|e| to_py(e.into()))?;
             check_mc_table_eta(kind, &medium).map_err(to_py)?;
             let model = make_model(kind, &medium);
             Ok(Model {
@@ -360,13 +358,13 @@ pub fn monte_carlo<'py>(
         photons,
         seed,
     };
-    check_budget(&req, sss_render::budget::default_budget()).map_err(to_py)?;
+    check_budget(&req, sss_render::budget::default_budget()).map_err(|e| to_py(e.into()))?;
     let table = run_cancellable(
         py,
         crate::progress::callback(progress, "photons")?,
         |monitor| {
             monitor.set_total(req.photons.saturating_mul(3));
-            compute(&req, &|n| monitor.set_done(n))
+            compute(&req, &|n| monitor.set_done(n)).map_err(Error::from)
         },
     )?;
     let r: Vec<f64> = table.rows.iter().map(|row| row.r).collect();

@@ -4,7 +4,7 @@
 //!
 //! Stopping: the renderer and the Monte Carlo walk have no cancel flag of their own, but both
 //! report progress from their inner loops ([`sss_render::progress::Progress`], the photon
-//! counter of `sss_cli::profile_table::compute`). When a callback raises or Ctrl-C arrives,
+//! counter of `sss_bssrdf::profile_rows::compute`). When a callback raises or Ctrl-C arrives,
 //! the monitor's `cancel` flag is set and the next progress report on any worker thread unwinds with
 //! [`Cancelled`] (through `resume_unwind`, which prints nothing); rayon carries the unwind to
 //! the helper thread, which catches it. Everything the call allocated is dropped on the way;
@@ -74,7 +74,7 @@ impl sss_render::progress::Progress for Monitor {
 /// The bar `progress=True` shows: one line on `sys.stderr`, redrawn with a carriage return
 /// (as tqdm draws in a terminal and in a notebook's output cell), `label  37% 2390/6456
 /// [00:03 < 5 seconds]`, the remaining time as the command line's bar gives it
-/// ([`sss_cli::progress::eta_text`]), a line break once everything is done.
+/// ([`sss_util::progress::eta_text`]), a line break once everything is done.
 #[pyclass(name = "TextBar", module = "sss")]
 pub struct TextBar {
     label: String,
@@ -105,7 +105,7 @@ impl TextBar {
         } else {
             Duration::ZERO
         };
-        let eta = sss_cli::progress::eta_text(elapsed, fraction as f32, eta);
+        let eta = sss_util::progress::eta_text(elapsed, fraction as f32, eta);
         format!(
             "{} {:3.0}% {done}/{total} [{} < {eta}]",
             self.label,

@@ -8,12 +8,11 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use sss_bssrdf::Rgb;
-use sss_cli::commands::render::{load_options, load_scene, with_mesh_hint};
 use sss_render::Error;
 use sss_render::image::{read_exr, read_exr_alpha};
 use sss_render::integrators::{self, MethodOptions};
 use sss_render::metrics::{error_figures, mean_ratio_rgb};
-use sss_render::scene::{Scene, load_str};
+use sss_render::scene::{LoadOptions, Scene, load_named, load_str};
 use sss_render::{RenderSettings, render as render_scene};
 use std::path::PathBuf;
 
@@ -32,14 +31,16 @@ fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene
     if let Ok(s) = scene.cast::<PyString>() {
         let text = s.to_cow()?;
         if text.contains('\n') {
-            let opts = load_options(mesh_dirs);
+            let opts = LoadOptions::with_dirs(mesh_dirs);
             let cwd = std::env::current_dir().ok();
             return guard(|| {
                 load_str(&text, "scene.toml", cwd.as_deref(), &opts)
-                    .map_err(|e| to_py(Error::Scene(with_mesh_hint(e, MESH_DIR_HINT))))
+                    .map_err(|e| to_py(Error::Scene(e.with_mesh_hint(MESH_DIR_HINT))))
             });
         }
-        return guard(|| load_scene(&text, mesh_dirs, MESH_DIR_HINT).map_err(to_py));
+        return guard(|| {
+            load_named(&text, mesh_dirs, MESH_DIR_HINT).map_err(|e| to_py(Error::Scene(e)))
+        });
     }
     let path: PathBuf = scene.extract().map_err(|_| {
         PyTypeError::new_err(
@@ -48,7 +49,7 @@ fn scene_from(scene: &Bound<'_, PyAny>, mesh_dirs: &[PathBuf]) -> PyResult<Scene
         )
     })?;
     let name = path.to_string_lossy().into_owned();
-    guard(|| load_scene(&name, mesh_dirs, MESH_DIR_HINT).map_err(to_py))
+    guard(|| load_named(&name, mesh_dirs, MESH_DIR_HINT).map_err(|e| to_py(Error::Scene(e))))
 }
 
 /// The options of `method` among those `given`, and a warning for each option given that

@@ -7,9 +7,8 @@ use crate::errors::{guard, to_py};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use sss_cli::commands::render::{load_options, load_scene, with_mesh_hint};
 use sss_render::Error;
-use sss_render::scene::{BUILTIN_SCENES, Scene as RustScene, load_str};
+use sss_render::scene::{BUILTIN_SCENES, LoadOptions, Scene as RustScene, load_named, load_str};
 use std::path::{Path, PathBuf};
 
 /// How a Python caller adds a mesh directory, for the error of a missing mesh.
@@ -127,10 +126,10 @@ fn load(
 ) -> PyResult<Scene> {
     let text = toml::to_string(&description)
         .map_err(|e| PyTypeError::new_err(format!("scene: cannot describe it as TOML: {e}")))?;
-    let opts = load_options(mesh_dirs);
+    let opts = LoadOptions::with_dirs(mesh_dirs);
     let scene = guard(|| {
         load_str(&text, file, base_dir, &opts)
-            .map_err(|e| to_py(Error::Scene(with_mesh_hint(e, MESH_DIR_HINT))))
+            .map_err(|e| to_py(Error::Scene(e.with_mesh_hint(MESH_DIR_HINT))))
     })?;
     Ok(Scene { scene, description })
 }
@@ -171,7 +170,8 @@ pub fn load_dict(
 pub fn load_file(path: PathBuf, mesh_dirs: Option<Vec<PathBuf>>) -> PyResult<Scene> {
     let mesh_dirs = mesh_dirs.unwrap_or_default();
     let name = path.to_string_lossy().into_owned();
-    let scene = guard(|| load_scene(&name, &mesh_dirs, MESH_DIR_HINT).map_err(to_py))?;
+    let scene =
+        guard(|| load_named(&name, &mesh_dirs, MESH_DIR_HINT).map_err(|e| to_py(Error::Scene(e))))?;
     let text = match BUILTIN_SCENES.iter().find(|(n, _)| *n == name) {
         Some((_, text)) if !path.exists() => text.to_string(),
         _ => std::fs::read_to_string(&path).map_err(|e| {

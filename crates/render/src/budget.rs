@@ -49,20 +49,9 @@ pub fn frame_bytes(width: u32, height: u32, spp: u32) -> u64 {
         .saturating_add(pixels.saturating_mul(BYTES_PER_PIXEL))
 }
 
-/// `n` bytes for a person: `1.5 GiB`.
+/// `n` bytes for a person: `1.5 GiB` ([`sss_util::human_bytes`]).
 pub fn human(n: u64) -> String {
-    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
-    let mut v = n as f64;
-    let mut u = 0;
-    while v >= 1024.0 && u + 1 < UNITS.len() {
-        v /= 1024.0;
-        u += 1;
-    }
-    if u == 0 {
-        format!("{n} B")
-    } else {
-        format!("{v:.1} {}", UNITS[u])
-    }
+    sss_util::human_bytes(n)
 }
 
 /// Parses a byte count: a number with an optional suffix K, M, G or T (powers of 1024, `B`
@@ -285,13 +274,6 @@ mod tests {
         for bad in ["", "x", "-1G", "0", "nanG", "1e30T"] {
             assert!(parse_bytes(bad).is_err(), "{bad}");
         }
-    }
-
-    #[test]
-    fn human_sizes() {
-        assert_eq!(human(512), "512 B");
-        assert_eq!(human(1536), "1.5 KiB");
-        assert_eq!(human(3 << 30), "3.0 GiB");
     }
 
     #[test]

@@ -68,7 +68,10 @@ impl std::error::Error for Error {
 
 impl From<BssrdfError> for Error {
     fn from(e: BssrdfError) -> Self {
-        Error::Bssrdf(e)
+        match e {
+            BssrdfError::NonFinite(msg) => Error::NonFinite(msg),
+            e => Error::Bssrdf(e),
+        }
     }
 }
 

@@ -39,10 +39,13 @@ pub struct IrradianceSettings {
 }
 
 impl Default for IrradianceSettings {
+    /// The declared defaults of `--spacing` and `--max-samples`
+    /// ([`crate::integrators::options::SAMPLE_OPTIONS`]), 16 light samples.
     fn default() -> Self {
+        use crate::integrators::options::{SAMPLE_OPTIONS, declared};
         IrradianceSettings {
-            spacing_mfp: 0.5,
-            max_samples: 100_000,
+            spacing_mfp: declared(&SAMPLE_OPTIONS, "spacing"),
+            max_samples: declared(&SAMPLE_OPTIONS, "max-samples"),
             light_samples: 16,
         }
     }

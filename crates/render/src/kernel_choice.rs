@@ -162,13 +162,17 @@ pub fn check_separable_options(taps: usize, k: f64, jitter: f32) -> Result<(), c
 }
 
 impl Default for SeparableSettings {
+    /// The declared defaults of the `separable` method's options
+    /// ([`crate::integrators::separable::OPTIONS`]; `--uniform-taps` off).
     fn default() -> Self {
+        use crate::integrators::options::declared;
+        use crate::integrators::separable::OPTIONS;
         SeparableSettings {
-            kernel: KernelMethod::Preintegrated,
-            taps: 7,
+            kernel: declared(&OPTIONS, "kernel"),
+            taps: declared(&OPTIONS, "taps"),
             importance: true,
-            k: 2.0,
-            jitter: 0.1,
+            k: declared(&OPTIONS, "k"),
+            jitter: declared(&OPTIONS, "jitter"),
         }
     }
 }

@@ -87,6 +87,7 @@ pub mod image;
 pub mod integrators;
 pub mod irradiance;
 pub mod kernel_choice;
+pub mod kernel_export;
 pub mod lights;
 pub mod metrics;
 pub mod pipeline;

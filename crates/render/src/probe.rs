@@ -19,9 +19,14 @@ use sss_bssrdf::{Rgb, SurfacePoint};
 use sss_scene::Light;
 use std::f64::consts::PI;
 
-/// The default energy fraction of each channel's profile inside its probe sphere
-/// (`--probe-energy`).
-pub const DEFAULT_PROBE_ENERGY: f64 = 0.9999;
+/// The default energy fraction of each channel's profile inside its probe sphere: the
+/// declared default of `--probe-energy` ([`crate::integrators::options::PROBE_ENERGY`]).
+pub fn default_probe_energy() -> f64 {
+    crate::integrators::options::declared(
+        &[crate::integrators::options::PROBE_ENERGY],
+        "probe-energy",
+    )
+}
 
 /// Probabilities of the three probe axes: first tangent, second tangent, normal (pbrt).
 const AXIS_PROB: [f64; 3] = [0.25, 0.25, 0.5];

@@ -8,7 +8,7 @@
 //! [`Object`]s whose triangle meshes are already transformed, cleaned (degenerate triangles
 //! dropped and counted) and given per-vertex shading normals. The file format (TOML) is
 //! documented in `scenes/README.md`; [`load()`] reads it, [`load_str`] parses text, [`builtin`]
-//! returns the scenes embedded in the crate. Every problem is a [`SceneError`] naming the file,
+//! returns the scenes embedded in the crate and [`load_named`] takes either, as `sss render` does. Every problem is a [`SceneError`] naming the file,
 //! the line and the key; loading never panics on bad input.
 //!
 //! Units: lengths in scene units; each translucent material says how many scene units make a
@@ -37,7 +37,7 @@ mod format;
 mod load;
 mod shapes;
 
-pub use load::{BUILTIN_SCENES, LoadOptions, builtin, load, load_str};
+pub use load::{BUILTIN_SCENES, LoadOptions, builtin, load, load_named, load_str};
 
 use glam::DVec3;
 use sss_bssrdf::{Medium, ModelKind, Rgb};

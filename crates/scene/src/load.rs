@@ -49,6 +49,60 @@ impl LoadOptions {
             .unwrap_or_default();
         LoadOptions { mesh_dirs }
     }
+
+    /// The mesh directories `dirs` (searched first), then those of `SSS_MESH_DIR`.
+    pub fn with_dirs(dirs: &[PathBuf]) -> Self {
+        let mut opts = LoadOptions::from_env();
+        let mut all = dirs.to_vec();
+        all.append(&mut opts.mesh_dirs);
+        opts.mesh_dirs = all;
+        opts
+    }
+}
+
+/// Loads a scene file, or a built-in scene when `name` is not a file but names one, with the
+/// mesh directories `mesh_dirs` (then `SSS_MESH_DIR`). `mesh_dir_hint` says how the caller's
+/// user adds a mesh directory (`--mesh-dir DIR` in the CLI, `mesh_dirs=[...]` in Python): a
+/// missing mesh's error names it ([`SceneError::with_mesh_hint`]), and a name that is neither a
+/// file nor a built-in scene lists the built-in scenes.
+pub fn load_named(
+    name: &str,
+    mesh_dirs: &[PathBuf],
+    mesh_dir_hint: &str,
+) -> Result<Scene, SceneError> {
+    let opts = LoadOptions::with_dirs(mesh_dirs);
+    let path = Path::new(name);
+    let is_builtin = BUILTIN_SCENES.iter().any(|(n, _)| *n == name);
+    let loaded = if !path.exists() && is_builtin {
+        builtin(name, &opts)
+    } else {
+        load(path, &opts)
+    };
+    loaded.map_err(|mut e| {
+        if e.kind == SceneErrorKind::Io && !path.exists() && !is_builtin {
+            let names: Vec<&str> = BUILTIN_SCENES.iter().map(|(n, _)| *n).collect();
+            e.message = format!(
+                "{}; nor is it a built-in scene ({})",
+                e.message,
+                names.join(", ")
+            );
+        }
+        e.with_mesh_hint(mesh_dir_hint)
+    })
+}
+
+impl SceneError {
+    /// The error with, when a mesh file was not found, how to add a directory: `hint` (the
+    /// caller's own way, `--mesh-dir DIR` say) or the `SSS_MESH_DIR` environment variable.
+    pub fn with_mesh_hint(mut self, hint: &str) -> SceneError {
+        if self.kind == SceneErrorKind::MeshNotFound {
+            self.message = format!(
+                "{}; add a mesh directory with {hint} or the SSS_MESH_DIR environment variable",
+                self.message
+            );
+        }
+        self
+    }
 }
 
 /// Loads a scene file. Relative mesh paths are resolved against the file's directory first,

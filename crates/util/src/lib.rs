@@ -10,6 +10,9 @@
 //!   Flood 2014, *Fast splittable pseudorandom number generators*, OOPSLA). Every random stream
 //!   of the toolkit is seeded by hashing a user seed with a work-item index through them, never
 //!   from a thread, so results are bit-identical for any thread count.
+//! - `progress` (feature `progress`, which adds indicatif): progress bars on stderr with a time
+//!   estimate that waits for evidence.
+//! - [`human_bytes`]: a byte count as people read it (`1.5 GiB`), for memory-budget messages.
 //! - [`write_atomic`] and [`write_atomic_with`]: write to a temporary file in the destination's
 //!   directory, then rename it into place. A reader never sees a half-written file and a failed
 //!   write leaves nothing behind.
@@ -36,6 +39,9 @@
 
 #![forbid(unsafe_code)]
 
+#[cfg(feature = "progress")]
+pub mod progress;
+
 use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -52,6 +58,22 @@ pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
 #[inline]
 pub fn luminance(c: Rgb) -> f64 {
     LUMINANCE[0] * c[0] + LUMINANCE[1] * c[1] + LUMINANCE[2] * c[2]
+}
+
+/// `n` bytes for a person, in powers of 1024 with one decimal: `512 B`, `1.5 KiB`, `3.0 GiB`.
+pub fn human_bytes(n: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = n as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < UNITS.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{n} B")
+    } else {
+        format!("{v:.1} {}", UNITS[u])
+    }
 }
 
 /// The SplitMix64 golden-ratio increment, ⌊2⁶⁴/φ⌋ (odd).
@@ -185,6 +207,15 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn human_sizes() {
+        assert_eq!(human_bytes(512), "512 B");
+        assert_eq!(human_bytes(1023), "1023 B");
+        assert_eq!(human_bytes(1536), "1.5 KiB");
+        assert_eq!(human_bytes(3 << 30), "3.0 GiB");
+        assert_eq!(human_bytes(u64::MAX), "16777216.0 TiB");
+    }
 
     /// Published SplitMix64 outputs: the reference C code (Vigna, splitmix64.c) seeded with 0
     /// yields these first three values; each call adds GOLDEN_GAMMA to the state.

@@ -400,6 +400,8 @@ impl CliFiles {
             "subsurface",
             "std_error",
             "--eps",
+            "--solid-angle",
+            "--rel-error",
             "--model",
             "standard-dipole",
             "better-dipole",

@@ -285,7 +285,7 @@ pub fn guard(dir: &Path, cli: &Cli) -> Option<&'static str> {
             if !outputs_ok(&[a.plot.as_ref()]) {
                 return Some("output outside the work directory");
             }
-            if a.model == sss_cli::profile_table::ProfileModel::MonteCarlo
+            if a.model == sss_bssrdf::profile_rows::ProfileModel::MonteCarlo
                 && a.photons > limits::PHOTONS
             {
                 return Some("monte-carlo profile with more than 20000 photons");

@@ -12,7 +12,7 @@
 use crate::args::MediumArgs;
 use crate::commands::render::check_output;
 use crate::method_flags::{MethodFlags, SeparableOnly};
-use crate::profile_table::build_medium;
+
 use clap::Args;
 use sss_bssrdf::{ModelKind, Rgb, make_model};
 use sss_render::Error;
@@ -94,7 +94,7 @@ pub fn run(args: &FilterArgs) -> Result<String, Error> {
     if let Some(p) = &args.png {
         check_output(p, "png")?;
     }
-    let medium = build_medium(&args.medium.spec()?, args.medium.eta)?;
+    let medium = args.medium.spec()?.medium(args.medium.eta)?;
     let model = make_model(args.model, &medium);
     let budget = args
         .max_memory

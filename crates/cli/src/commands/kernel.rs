@@ -1,49 +1,13 @@
 //! `sss kernel`: exports a separable subsurface-scattering kernel (Jimenez et al. 2015) for a
-//! material as JSON, CSV, or GLSL/HLSL/WGSL constants in the `float4(r, g, b, offset)` layout
-//! of the public 2012 separable-SSS shader code.
-//!
-//! Weights: for a rank-1 kernel (every method but `svd3`, `svd6` and `gaussians6`) the exported
-//! taps are the 1D profile a(x) of Eq. 5 whose weights sum to the model's total diffuse
-//! reflectance R per channel; the 2D kernel is a(x) a(y) / R, so a shader applies the taps in
-//! both passes and divides by R once (or, with `--normalize`, uses weights summing to 1 in both
-//! passes and multiplies by R, or by its own albedo, afterwards). Multi-term kernels export
-//! each term's horizontal and vertical taps as stored (their products sum to R).
-//!
-//! The JSON text comes from `sss_separable::kernel_json` (`KernelFile::to_json`), whose
-//! `KernelFile::from_json` reads it back. The shader text comes from `sss_separable::shader`
-//! (the same constants for engines that use the library directly): one array `sssKernel` for a
-//! rank-1 kernel, `sssKernelH{i}` and `sssKernelV{i}` per term otherwise; WGSL adds each
-//! array's tap count `{name}Taps`, which WGSL cannot query.
-//! `crates/separable/examples/separable_sss.wgsl` is a two-pass compute shader that applies a
-//! pasted WGSL export with the CPU filter's silhouette rules.
+//! material; the text and its layout are `sss_render::kernel_export`'s (see there).
 
-use crate::args::{MediumArgs, model_help};
-use crate::profile_table::{MediumSpec, build_medium};
-use clap::{Args, ValueEnum};
-use sss_bssrdf::{ModelKind, Rgb, make_model};
+use crate::args::{MediumArgs, model_help, names_parser};
+use clap::Args;
+use sss_bssrdf::{MediumSpec, ModelKind};
 use sss_render::Error;
-use sss_render::kernel_choice::check_separable_options;
-use sss_render::kernel_choice::{KernelMethod, MaterialKernel, SeparableSettings, build_kernel};
-use sss_separable::kernel_json::KernelFile;
-use sss_separable::shader::{self, ShaderLanguage, ShaderTaps};
-use sss_separable::{Energy, Kernel1d, TapPlacement, artist};
-use std::fmt::Write as _;
-
-/// Output formats of `sss kernel`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum KernelFormat {
-    /// `{"method": ..., "taps": [{"offset_mm": x, "weights": [r, g, b]}, ...], ...}`.
-    Json,
-    /// `term,direction,offset_mm,weight_r,weight_g,weight_b`.
-    Csv,
-    /// GLSL `vec4` array constants (`const vec4 sssKernel[N] = vec4[](...);`).
-    Glsl,
-    /// HLSL `float4` array constants (`static const float4 sssKernel[N] = {...};`).
-    Hlsl,
-    /// WGSL `vec4<f32>` array constants (`const sssKernel: array<vec4<f32>, N> = ...;`) and
-    /// their tap counts (`const sssKernelTaps: u32 = Nu;`).
-    Wgsl,
-}
+use sss_render::kernel_choice::KernelMethod;
+use sss_render::kernel_export::{KernelFormat, KernelRequest, export};
+use sss_separable::artist;
 
 /// Arguments of `sss kernel`.
 #[derive(Debug, Args)]
@@ -52,11 +16,11 @@ pub struct KernelArgs {
     #[command(flatten)]
     pub medium: MediumArgs,
     /// The BSSRDF model whose R_d is approximated (the help lists `ModelKind::ALL`).
-    #[arg(long, default_value = "better-dipole", help = model_help("The BSSRDF model whose R_d is approximated"))]
+    #[arg(long, default_value_t = defaults().model, help = model_help("The BSSRDF model whose R_d is approximated"))]
     pub model: ModelKind,
     /// The kernel (the help lists the separable ones of `KernelMethod::ALL`; `artist` is
     /// fitted to the material).
-    #[arg(long, default_value = "preintegrated", help = format!(
+    #[arg(long, default_value_t = defaults().method, help = format!(
         "The kernel (one of: {}; artist is fitted to the material)",
         KernelMethod::separable_names().join(", ")
     ))]
@@ -69,301 +33,47 @@ pub struct KernelArgs {
     ))]
     pub artist_preset: Option<String>,
     /// Guided-optimisation exponent k in [0, 4].
-    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = defaults().k, allow_hyphen_values = true)]
     pub k: f64,
     /// Taps per 1D pass.
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = defaults().taps)]
     pub taps: usize,
     /// Place taps uniformly instead of by importance (SVD terms always are).
     #[arg(long)]
     pub uniform: bool,
     /// Output format; shader constants are in the float4(r, g, b, offset_mm) layout, centre
     /// tap first.
-    #[arg(long, value_enum, default_value_t = KernelFormat::Json)]
+    #[arg(long, default_value_t = defaults().format, value_parser = names_parser::<KernelFormat>(KernelFormat::ALL.map(|f| f.name())))]
     pub format: KernelFormat,
     /// Scale the weights to sum to 1 instead of the total diffuse reflectance.
     #[arg(long)]
     pub normalize: bool,
 }
 
-fn num(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v:e}")
-    } else {
-        "0".into()
-    }
+/// The library's defaults ([`KernelRequest::new`]), the flags' only source of them.
+fn defaults() -> KernelRequest {
+    KernelRequest::new(MediumSpec::Preset(String::new()))
 }
 
-/// What every format of `sss kernel` prints: the kernel's name, the model's total diffuse
-/// reflectance, and the taps as a shader applies them.
-struct Exported {
-    /// `preintegrated`, `artist:production`, `guided:k=2`, ...
-    method: String,
-    /// The medium as given.
-    spec: MediumSpec,
-    /// The model's total diffuse reflectance per channel.
-    total: Rgb,
-    /// The taps ([`ShaderTaps::new`] with the energy `--normalize` asks for).
-    taps: ShaderTaps,
-}
-
-/// Builds the kernel `args` ask for and its exported taps.
-fn export(args: &KernelArgs) -> Result<Exported, Error> {
-    check_separable_options(args.taps, args.k, 0.0)?;
-    if !args.method.is_separable() {
-        return Err(Error::Input(format!(
-            "--method {} is the full 2D kernel, not a separable one; choose one of {}",
-            args.method,
-            KernelMethod::separable_names().join(", ")
-        )));
+impl KernelArgs {
+    /// The library request these arguments describe.
+    pub fn request(&self) -> Result<KernelRequest, Error> {
+        Ok(KernelRequest {
+            medium: self.medium.spec()?,
+            eta: self.medium.eta,
+            model: self.model,
+            method: self.method,
+            artist_preset: self.artist_preset.clone(),
+            k: self.k,
+            taps: self.taps,
+            uniform: self.uniform,
+            format: self.format,
+            normalize: self.normalize,
+        })
     }
-    if args.artist_preset.is_some() && args.method != KernelMethod::Artist {
-        return Err(Error::Input("--artist-preset needs --method artist".into()));
-    }
-    let spec = args.medium.spec()?;
-    let medium = build_medium(&spec, args.medium.eta)?;
-    let model = make_model(args.model, &medium);
-    let total: Rgb = std::array::from_fn(|c| model.total_diffuse_reflectance(c));
-    let placement = if args.uniform {
-        TapPlacement::Uniform(args.taps)
-    } else {
-        TapPlacement::Importance(args.taps)
-    };
-    let kernel = match &args.artist_preset {
-        Some(name) => {
-            let params = artist::preset(name).map_err(|e| Error::Input(e.to_string()))?;
-            artist::kernel(&params, total, placement).map_err(|e| Error::Input(e.to_string()))?
-        }
-        None => {
-            let settings = SeparableSettings {
-                kernel: args.method,
-                taps: args.taps,
-                importance: !args.uniform,
-                k: args.k,
-                jitter: 0.0,
-            };
-            match build_kernel(model.as_ref(), &settings)
-                .map_err(|e| Error::Input(e.to_string()))?
-            {
-                MaterialKernel::Separable(k) => k,
-                MaterialKernel::Full(_) => unreachable!("exact2d is rejected above"),
-            }
-        }
-    };
-    if !kernel.is_finite() {
-        return Err(Error::NonFinite(format!(
-            "the {} kernel has a non-finite weight",
-            args.method
-        )));
-    }
-    let method = match &args.artist_preset {
-        Some(p) => format!("artist:{p}"),
-        None if args.method == KernelMethod::Guided => format!("guided:k={}", args.k),
-        None => args.method.to_string(),
-    };
-    let energy = if args.normalize {
-        Energy::Unit
-    } else {
-        Energy::TotalReflectance
-    };
-    Ok(Exported {
-        method,
-        spec,
-        total,
-        taps: ShaderTaps::new(&kernel, total, energy),
-    })
 }
 
 /// Runs `sss kernel`: the kernel text for stdout.
 pub fn run(args: &KernelArgs) -> Result<String, Error> {
-    let Exported {
-        method,
-        spec,
-        total,
-        taps: exported,
-    } = export(args)?;
-    let mut out = String::new();
-    match args.format {
-        KernelFormat::Json => {
-            let file = KernelFile {
-                method,
-                model: args.model.to_string(),
-                normalized: args.normalize,
-                total_diffuse_reflectance: total,
-                taps: exported,
-            };
-            let text = file
-                .to_json()
-                .map_err(|e| Error::NonFinite(format!("the {} kernel: {e}", args.method)))?;
-            out.push_str(&text);
-        }
-        KernelFormat::Csv => {
-            out.push_str("term,direction,offset_mm,weight_r,weight_g,weight_b\n");
-            let mut rows = |term: usize, dir: &str, k: &Kernel1d| {
-                for t in &k.taps {
-                    let _ = writeln!(
-                        out,
-                        "{term},{dir},{},{},{},{}",
-                        num(t.offset_mm),
-                        num(t.weight[0]),
-                        num(t.weight[1]),
-                        num(t.weight[2])
-                    );
-                }
-            };
-            match &exported {
-                ShaderTaps::Rank1(t) => rows(0, "both", t),
-                ShaderTaps::Terms(terms) => {
-                    for (i, t) in terms.iter().enumerate() {
-                        rows(i, "horizontal", &t.horizontal);
-                        rows(i, "vertical", &t.vertical);
-                    }
-                }
-            }
-        }
-        KernelFormat::Glsl | KernelFormat::Hlsl | KernelFormat::Wgsl => {
-            let language = match args.format {
-                KernelFormat::Glsl => ShaderLanguage::Glsl,
-                KernelFormat::Hlsl => ShaderLanguage::Hlsl,
-                _ => ShaderLanguage::Wgsl,
-            };
-            let _ = writeln!(
-                out,
-                "// {} kernel of {} ({}), {} taps: float4(r, g, b, offset in mm), centre tap first.",
-                method,
-                match &spec {
-                    MediumSpec::Preset(p) => p.clone(),
-                    MediumSpec::Coefficients { .. } => "custom medium".into(),
-                },
-                args.model,
-                args.taps
-            );
-            let _ = writeln!(
-                out,
-                "// Weights sum to {}; total diffuse reflectance ({}, {}, {}).",
-                if args.normalize {
-                    "1"
-                } else {
-                    "the total diffuse reflectance"
-                },
-                num(total[0]),
-                num(total[1]),
-                num(total[2])
-            );
-            let text = shader::constants(&exported, language)
-                .map_err(|e| Error::NonFinite(format!("the {} kernel: {e}", args.method)))?;
-            out.push_str(&text);
-        }
-    }
-    Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::{Cli, Command};
-    use clap::Parser;
-
-    /// The JSON writer `sss kernel` had before it moved to `sss_separable::kernel_json`,
-    /// verbatim: the library's text must stay byte for byte what users' files hold.
-    fn old_json(args: &KernelArgs, e: &Exported, passes: usize) -> String {
-        fn taps_json(k: &Kernel1d) -> String {
-            let items: Vec<String> = k
-                .taps
-                .iter()
-                .map(|t| {
-                    format!(
-                        "{{\"offset_mm\": {}, \"weights\": [{}, {}, {}]}}",
-                        num(t.offset_mm),
-                        num(t.weight[0]),
-                        num(t.weight[1]),
-                        num(t.weight[2])
-                    )
-                })
-                .collect();
-            format!("[{}]", items.join(", "))
-        }
-        let mut out = String::new();
-        let total = e.total;
-        let _ = write!(
-            out,
-            "{{\"method\": \"{}\", \"model\": \"{}\", \"normalized\": {}, \"total_diffuse_reflectance\": [{}, {}, {}], \"passes\": {}",
-            e.method,
-            args.model,
-            args.normalize,
-            num(total[0]),
-            num(total[1]),
-            num(total[2]),
-            passes
-        );
-        match &e.taps {
-            ShaderTaps::Rank1(t) => {
-                let _ = write!(out, ", \"taps\": {}", taps_json(t));
-            }
-            ShaderTaps::Terms(terms) => {
-                let terms: Vec<String> = terms
-                    .iter()
-                    .map(|t| {
-                        format!(
-                            "{{\"horizontal\": {}, \"vertical\": {}}}",
-                            taps_json(&t.horizontal),
-                            taps_json(&t.vertical)
-                        )
-                    })
-                    .collect();
-                let _ = write!(out, ", \"terms\": [{}]", terms.join(", "));
-            }
-        }
-        out.push_str("}\n");
-        out
-    }
-
-    fn kernel_args(args: &[&str]) -> KernelArgs {
-        let cli = Cli::try_parse_from([&["sss", "kernel"], args].concat()).unwrap();
-        match cli.command {
-            Command::Kernel(a) => a,
-            _ => unreachable!("parsed `sss kernel`"),
-        }
-    }
-
-    /// `sss kernel --format json` prints what the old writer printed, for rank-1 and
-    /// multi-term kernels, plain and normalised, and the library reads it back to the same
-    /// taps.
-    #[test]
-    fn kernel_json_is_the_old_text_and_reads_back() {
-        for method in [
-            &["--method", "preintegrated"][..],
-            &["--method", "svd3", "--taps", "5"],
-            &["--method", "gaussians6", "--taps", "3"],
-            &["--method", "guided", "--k", "1.5"],
-            &["--method", "artist", "--artist-preset", "production"],
-            &["--method", "svd1", "--uniform", "--taps", "4"],
-        ] {
-            for normalize in [false, true] {
-                let mut a = vec!["--preset", "marble"];
-                a.extend_from_slice(method);
-                if normalize {
-                    a.push("--normalize");
-                }
-                let args = kernel_args(&a);
-                let e = export(&args).unwrap();
-                // The old writer printed the kernel's `passes()`, 2 per term; `ShaderTaps::new`
-                // gives `Rank1` exactly for one term.
-                let passes = match &e.taps {
-                    ShaderTaps::Rank1(_) => 2,
-                    ShaderTaps::Terms(t) => 2 * t.len(),
-                };
-                let text = run(&args).unwrap();
-                assert_eq!(text, old_json(&args, &e, passes), "{a:?}");
-                let back = KernelFile::from_json(&text).unwrap();
-                assert_eq!(back.taps, e.taps, "{a:?}");
-                assert_eq!(back.total_diffuse_reflectance, e.total);
-                assert_eq!(back.normalized, normalize);
-                assert_eq!(
-                    (back.method.as_str(), back.passes()),
-                    (e.method.as_str(), passes)
-                );
-            }
-        }
-    }
+    export(&args.request()?)
 }

@@ -1,18 +1,19 @@
 //! `sss profile`: the radial profile R_d(r) of a model (or the Monte Carlo reference) as CSV,
 //! optionally plotted.
 
-use crate::args::MediumArgs;
+use crate::args::{MediumArgs, names_parser};
 use crate::plot_error;
-use crate::profile_table::{ProfileModel, ProfileRequest, check_budget, compute};
 use clap::Args;
+use sss_bssrdf::profile_rows::{ProfileModel, ProfileRequest, ProfileRows, check_budget, compute};
+use sss_plot::{CHANNEL_COLORS, ErrorStyle, PlotError, Series, line_plot};
 use sss_render::Error;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `sss profile`.
 #[derive(Debug, Args)]
 pub struct ProfileArgs {
     /// The model, or the Monte Carlo reference.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = names_parser::<ProfileModel>(ProfileModel::ALL.map(|m| m.name())))]
     pub model: ProfileModel,
     /// The medium.
     #[command(flatten)]
@@ -84,7 +85,7 @@ pub fn run(args: &ProfileArgs) -> Result<Vec<u8>, Error> {
     }
     let table = table?;
     if let Some(path) = &args.plot {
-        table.plot(path, req.log).map_err(plot_error)?;
+        plot(&table, path, req.log).map_err(plot_error)?;
     }
     let mut buf = Vec::new();
     table.write_csv(&mut buf).map_err(|source| Error::Io {
@@ -92,4 +93,28 @@ pub fn run(args: &ProfileArgs) -> Result<Vec<u8>, Error> {
         source,
     })?;
     Ok(buf)
+}
+
+/// Draws the three channels of `rows` on a log y axis (log x too when `log_x`), Monte Carlo
+/// with its standard errors as a band, to `path` (`.png` or `.svg`).
+pub fn plot(rows: &ProfileRows, path: &Path, log_x: bool) -> Result<(), PlotError> {
+    let names = ["red", "green", "blue"];
+    let series: Vec<Series> = (0..3)
+        .map(|ch| {
+            let points = rows.rows.iter().map(|r| (r.r, r.rd[ch])).collect();
+            let s = Series::line(names[ch], points).with_color(CHANNEL_COLORS[ch]);
+            if rows.has_se() {
+                let err = rows
+                    .rows
+                    .iter()
+                    .map(|r| r.se.map_or(0.0, |se| se[ch]))
+                    .collect();
+                s.with_errors(err, ErrorStyle::Band)
+            } else {
+                s
+            }
+        })
+        .collect();
+    let title = format!("Rd(r), {}: {}", rows.model.name(), rows.medium_label);
+    line_plot(path, &title, "r (mm)", "Rd (1/mm²)", &series, log_x, true)
 }

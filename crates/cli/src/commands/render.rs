@@ -8,7 +8,7 @@ use sss_bssrdf::Rgb;
 use sss_render::Error;
 use sss_render::image::{exposure_or_auto, write_exr, write_exr_with, write_png};
 use sss_render::integrators::{self, Integrator, MethodOptions};
-use sss_render::scene::{self, LoadOptions, Scene};
+use sss_render::scene::{self, Scene};
 use sss_render::{RenderOutput, RenderSettings, render};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -93,53 +93,6 @@ pub fn integrator(method: &str, given: &MethodOptions) -> Result<Box<dyn Integra
     integrators::build(method, &options)
 }
 
-/// Loads a scene file, or a built-in scene when `name` is not a file but names one.
-/// `mesh_dir_hint` says how this caller's user adds a mesh directory (`--mesh-dir DIR` in the
-/// CLI, `mesh_dirs=[...]` in Python): a missing mesh's error names it ([`with_mesh_hint`]),
-/// and a name that is neither a file nor a built-in scene lists the built-in scenes.
-pub fn load_scene(name: &str, mesh_dirs: &[PathBuf], mesh_dir_hint: &str) -> Result<Scene, Error> {
-    let opts = load_options(mesh_dirs);
-    let path = Path::new(name);
-    let builtin = scene::BUILTIN_SCENES.iter().any(|(n, _)| *n == name);
-    let loaded = if !path.exists() && builtin {
-        scene::builtin(name, &opts)
-    } else {
-        scene::load(path, &opts)
-    };
-    loaded.map_err(|mut e| {
-        if e.kind == scene::SceneErrorKind::Io && !path.exists() && !builtin {
-            let names: Vec<&str> = scene::BUILTIN_SCENES.iter().map(|(n, _)| *n).collect();
-            e.message = format!(
-                "{}; nor is it a built-in scene ({})",
-                e.message,
-                names.join(", ")
-            );
-        }
-        Error::Scene(with_mesh_hint(e, mesh_dir_hint))
-    })
-}
-
-/// The mesh directories `dirs` (searched first), then those of `SSS_MESH_DIR`.
-pub fn load_options(dirs: &[PathBuf]) -> LoadOptions {
-    let mut opts = LoadOptions::from_env();
-    let mut all = dirs.to_vec();
-    all.append(&mut opts.mesh_dirs);
-    opts.mesh_dirs = all;
-    opts
-}
-
-/// A scene error with, when a mesh file was not found, how to add a directory: `hint` (the
-/// caller's own way, `--mesh-dir DIR` say) or the `SSS_MESH_DIR` environment variable.
-pub fn with_mesh_hint(mut e: scene::SceneError, hint: &str) -> scene::SceneError {
-    if e.kind == scene::SceneErrorKind::MeshNotFound {
-        e.message = format!(
-            "{}; add a mesh directory with {hint} or the SSS_MESH_DIR environment variable",
-            e.message
-        );
-    }
-    e
-}
-
 /// Checks that `path` ends in `.ext` and that its directory is writable.
 pub fn check_output(path: &Path, ext: &str) -> Result<(), Error> {
     let ok = path
@@ -190,7 +143,7 @@ pub fn run(args: &RenderArgs) -> Result<String, Error> {
         }
         check_output(p, "exr")?;
     }
-    let mut scene = load_scene(&args.scene, &args.mesh_dir, "--mesh-dir DIR")?;
+    let mut scene = scene::load_named(&args.scene, &args.mesh_dir, "--mesh-dir DIR")?;
     if let Some((w, h)) = args.resolution {
         scene.camera.width = w;
         scene.camera.height = h;

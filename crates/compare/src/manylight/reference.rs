@@ -21,7 +21,7 @@ use rayon::prelude::*;
 use sss_bssrdf::Rgb;
 use sss_render::frame::Frame;
 use sss_render::integrators::pathtrace::{
-    DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch, probe_radii,
+    ProbeRadii, Sampler, Scratch, default_probe_energy, probe_radii,
 };
 use sss_render::rng::{Stream, rng};
 use std::time::Instant;
@@ -193,7 +193,7 @@ pub fn path_reference(
     log: &dyn Fn(&str),
 ) -> Reference {
     let t0 = Instant::now();
-    let (radii, missed) = probe_radii(&frame.shading, DEFAULT_PROBE_ENERGY);
+    let (radii, missed) = probe_radii(&frame.shading, default_probe_energy());
     let gb = &frame.gbuffer;
     let k = f64::from(gb.samples_per_pixel.max(1));
     // The translucent camera samples of each pixel.

@@ -49,7 +49,7 @@ impl Experiment for ProfileComparison {
     fn run(&self, ctx: &Context<'_>) -> Result<Section, Error> {
         let methods = methods();
         let method_names: Vec<String> = methods.iter().map(|m| m.name()).collect();
-        let bar = sss_cli::progress::bar(ctx.references.len() as u64, "presets");
+        let bar = sss_util::progress::bar(ctx.references.len() as u64, "presets");
         bar.set_message("profiles");
         let mut evals = Vec::new();
         let mut body = String::new();

@@ -107,7 +107,7 @@ impl std::fmt::Display for Shard {
 /// else.
 pub fn prepare(config: &Config, ctx_log: &dyn Fn(&str)) -> Result<(), Error> {
     let presets = super::check(config)?;
-    let bar = sss_cli::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
+    let bar = sss_util::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
     reference::load_or_compute(config, &presets, ctx_log, &bar)?;
     bar.finish_and_clear();
     let ctx = Context {
@@ -166,7 +166,7 @@ pub fn run_shard(config: &Config, shard: Shard, log: &dyn Fn(&str)) -> Result<()
         config.out.display()
     ));
     if mine.contains(&Work::Profiles) {
-        let bar = sss_cli::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
+        let bar = sss_util::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
         let references = reference::load_or_compute(config, &presets, log, &bar)?;
         bar.finish_and_clear();
         let ctx = Context {

@@ -37,6 +37,21 @@ pub struct OptionSpec {
     pub values: &'static [&'static str],
 }
 
+/// Options that were renamed, with the names that replace them and what each means: a caller
+/// who gives an old name is refused with a message naming the new one its method takes
+/// ([`MethodOptions::check_known`]). `--eps` meant a solid angle for the trees and a relative
+/// error for the many-light methods; each quantity now has its own name.
+pub const RENAMED: [(&str, &[(&str, &str)]); 1] = [(
+    "eps",
+    &[
+        ("solid-angle", "is the tree methods' solid-angle threshold"),
+        (
+            "rel-error",
+            "is the many-light methods' relative error target",
+        ),
+    ],
+)];
+
 /// Option values given by a caller, by option name; options not given take their defaults.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct MethodOptions {
@@ -77,7 +92,9 @@ impl MethodOptions {
         let mut taken = MethodOptions::new();
         let mut others = Vec::new();
         for (name, value) in &self.values {
-            if method.options.iter().any(|o| o.name == name) {
+            // A renamed option stays with the method, which refuses it naming the new one.
+            let renamed = RENAMED.iter().any(|(old, _)| old == name);
+            if renamed || method.options.iter().any(|o| o.name == name) {
                 taken.set(name, value);
             } else {
                 others.push(name.clone());
@@ -89,6 +106,23 @@ impl MethodOptions {
     /// Fails when an option given is not one of `method`'s.
     pub fn check_known(&self, method: &Method) -> Result<(), Error> {
         for name in self.names() {
+            if let Some((_, new)) = RENAMED.iter().find(|(old, _)| *old == name) {
+                let meanings: Vec<String> = new
+                    .iter()
+                    .map(|(n, what)| format!("--{n} {what}"))
+                    .collect();
+                let taken = new
+                    .iter()
+                    .find(|(n, _)| method.options.iter().any(|o| o.name == *n));
+                let which = match taken {
+                    Some((n, _)) => format!("method {} takes --{n}", method.name),
+                    None => format!("method {} takes neither", method.name),
+                };
+                return Err(Error::Input(format!(
+                    "--{name} is no longer an option: {which} ({})",
+                    meanings.join("; ")
+                )));
+            }
             if !method.options.iter().any(|o| o.name == name) {
                 let known: Vec<String> = method
                     .options
@@ -157,10 +191,10 @@ pub const MAX_SAMPLES: OptionSpec = OptionSpec {
 /// The irradiance-sample options every point sum takes first: [`SPACING`], [`MAX_SAMPLES`].
 pub const SAMPLE_OPTIONS: [OptionSpec; 2] = [SPACING, MAX_SAMPLES];
 
-/// `--eps E` of the tree traversals (`single-tree`, `dual-tree`, `dual-tree-fmm`): the
-/// solid-angle threshold of Jensen & Buhler 2002 and Milaenen et al. 2019.
-pub const SOLID_ANGLE_EPS: OptionSpec = OptionSpec {
-    name: "eps",
+/// `--solid-angle E` of the tree traversals (`single-tree`, `dual-tree`, `dual-tree-fmm`):
+/// the solid-angle threshold ε of Jensen & Buhler 2002 and Milaenen et al. 2019.
+pub const SOLID_ANGLE: OptionSpec = OptionSpec {
+    name: "solid-angle",
     value_name: "E",
     default: "0.05",
     help: "Solid-angle threshold ε: a node of irradiance samples stands for all of them \
@@ -194,19 +228,25 @@ pub const MAX_TRIPLETS: OptionSpec = OptionSpec {
 };
 
 /// `--dark-floor F` of the many-light estimator (`manylight`, `sparse-manylight`).
+///
+/// Its default, 10⁻⁶, is about 20 stops below the frame's bright level, darker than any display
+/// or tone curve shows. Pixels that dark (in a point-lit head's own shadow, 10⁻⁸ of the median)
+/// otherwise refine to the triplet cap for a relative error nobody sees: the triplets' bounds
+/// ignore visibility, so the refinement splits the shadowed clusters next to the pixel, whose
+/// samples are all 0, long before the faint far ones that carry its value.
 pub const DARK_FLOOR: OptionSpec = OptionSpec {
     name: "dark-floor",
     value_name: "F",
     default: "1e-6",
-    help: "Pixels darker than F times the frame's bright level (the 90th percentile of a 32-pixel pilot at eps 0.2) stop at an absolute error of eps * F * that level instead of eps times their own value; 0: the paper's purely relative criterion",
+    help: "Pixels darker than F times the frame's bright level (the 90th percentile of a 32-pixel pilot at rel-error 0.2) stop at an absolute error of rel-error * F * that level instead of rel-error times their own value; 0: the paper's purely relative criterion",
     kind: OptionKind::Value,
     values: &[],
 };
 
-/// `--eps E` of the Student-t estimators (`manylight`, `eelc`): the relative error target
-/// of Nabata & Iwasaki.
-pub const RELATIVE_EPS: OptionSpec = OptionSpec {
-    name: "eps",
+/// `--rel-error E` of the Student-t estimators (`manylight`, `eelc`): the relative error
+/// target ε of Nabata & Iwasaki.
+pub const REL_ERROR: OptionSpec = OptionSpec {
+    name: "rel-error",
     value_name: "E",
     default: "0.02",
     help: "Relative error threshold: refine each pixel until its Student-t interval is below E times its value (the paper uses 0.02)",
@@ -254,6 +294,18 @@ pub const UNIFORM_POINTS: OptionSpec = OptionSpec {
     values: &[],
 };
 
+/// `--probe-energy F` of `pathtrace`, whose default is also the probe sampler's for the
+/// methods that draw points with it ([`crate::probe::default_probe_energy`]).
+pub const PROBE_ENERGY: OptionSpec = OptionSpec {
+    name: "probe-energy",
+    value_name: "F",
+    default: "0.9999",
+    help: "Fraction of each channel's profile energy inside its probe sphere, in (0, 1); the \
+           energy beyond the largest sphere is never sampled (stat probe_missed_energy)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
 /// `--max-pairs N` (`mdlc`, `eelc`).
 pub const MAX_PAIRS: OptionSpec = OptionSpec {
     name: "max-pairs",
@@ -263,6 +315,33 @@ pub const MAX_PAIRS: OptionSpec = OptionSpec {
     kind: OptionKind::Value,
     values: &[],
 };
+
+/// The declared default of option `name` of `specs`, parsed: what a settings type's
+/// `Default` reads, so that each default is stated once, in its [`OptionSpec`]. Panics only
+/// when a declaration's own default does not parse (a bug the registry's contract test
+/// catches: every method builds from its declared defaults).
+pub(crate) fn declared<T: FromStr>(specs: &[OptionSpec], name: &str) -> T
+where
+    T::Err: std::fmt::Display,
+{
+    match MethodOptions::new().get(specs, name) {
+        Ok(v) => v,
+        Err(e) => panic!("the declared default of --{name} does not parse: {e}"),
+    }
+}
+
+/// The settings `build` makes of no options given, i.e. of the declared defaults: a settings
+/// type's `Default` when its defaults are all options. Panics only when the declared defaults
+/// do not build (a bug the registry's contract test catches).
+pub(crate) fn from_declared<T>(
+    what: &str,
+    build: impl FnOnce(&MethodOptions) -> Result<T, Error>,
+) -> T {
+    match build(&MethodOptions::new()) {
+        Ok(v) => v,
+        Err(e) => panic!("the declared defaults of {what} do not build: {e}"),
+    }
+}
 
 /// Reads and checks the irradiance-sample options ([`SAMPLE_OPTIONS`]).
 pub fn sample_settings(o: &MethodOptions) -> Result<IrradianceSettings, Error> {
@@ -279,12 +358,13 @@ pub fn sample_settings(o: &MethodOptions) -> Result<IrradianceSettings, Error> {
     })
 }
 
-/// Reads and checks `--eps` of `options` (finite, ≥ 0; every method's ε has that range).
-pub fn eps_option(o: &MethodOptions, options: &[OptionSpec]) -> Result<f64, Error> {
-    let eps: f64 = o.get(options, "eps")?;
+/// Reads and checks the threshold `name` of `options` (`solid-angle` or `rel-error`: finite,
+/// ≥ 0; every method's ε has that range).
+pub fn eps_option(o: &MethodOptions, options: &[OptionSpec], name: &str) -> Result<f64, Error> {
+    let eps: f64 = o.get(options, name)?;
     if !(eps.is_finite() && eps >= 0.0) {
         return Err(Error::Input(format!(
-            "--eps must be finite and >= 0, got {eps}"
+            "--{name} must be finite and >= 0, got {eps}"
         )));
     }
     Ok(eps)
@@ -336,5 +416,43 @@ mod tests {
         let msg = bad.unwrap_err().to_string();
         assert!(msg.starts_with("--n: invalid value `x`"), "{msg}");
         assert!(none.get::<u32>(SPECS, "missing").is_err());
+    }
+
+    /// `--eps` is refused by every method, naming the option that replaced it there: the
+    /// trees' solid angle, the many-light methods' relative error, or neither; a method that
+    /// is only handed it through `partition` refuses it too (it is not ignored as another
+    /// method's option).
+    #[test]
+    fn the_old_eps_is_refused_naming_its_replacement() {
+        let trees = ["single-tree", "dual-tree", "dual-tree-fmm"];
+        let vpl = ["manylight", "sparse-manylight", "mdlc", "eelc"];
+        let given = MethodOptions::new().with("eps", 0.1).with("taps", 5);
+        for m in crate::integrators::METHODS {
+            let (taken, others) = given.partition(m);
+            assert!(taken.names().any(|n| n == "eps"), "{}", m.name);
+            assert!(!others.iter().any(|n| n == "eps"), "{}", m.name);
+            let msg = crate::integrators::build(m.name, &taken)
+                .err()
+                .unwrap_or_else(|| panic!("{} took --eps", m.name))
+                .to_string();
+            assert!(msg.starts_with("--eps is no longer an option: "), "{msg}");
+            let new = if trees.contains(&m.name) {
+                "takes --solid-angle"
+            } else if vpl.contains(&m.name) {
+                "takes --rel-error"
+            } else {
+                "takes neither"
+            };
+            assert!(msg.contains(&format!("method {} {new}", m.name)), "{msg}");
+            // Every method takes at most one of the new names, and the new name builds.
+            let takes: Vec<&str> = ["solid-angle", "rel-error"]
+                .into_iter()
+                .filter(|n| m.options.iter().any(|o| o.name == *n))
+                .collect();
+            assert!(takes.len() <= 1, "{}: {takes:?}", m.name);
+            for n in takes {
+                crate::integrators::build(m.name, &MethodOptions::new().with(n, 0.1)).unwrap();
+            }
+        }
     }
 }

@@ -2,7 +2,7 @@
 //! shading point x_o a radius is drawn from one channel's profile, mapped onto the object by a
 //! probe chord along one of three axes of the local frame (normal with probability 1/2, each
 //! tangent 1/4) inside the sphere holding a fraction `--probe-energy` (default
-//! [`DEFAULT_PROBE_ENERGY`]) of that channel's energy, one of the chord's hits on the same
+//! [`default_probe_energy`]) of that channel's energy, one of the chord's hits on the same
 //! object is chosen uniformly, and the direct light there (shadow rays, one light sample per
 //! area or environment light) is weighted by the BSSRDF over the combined density of all
 //! 3 × 3 axis-channel techniques (multiple importance sampling, the balance heuristic).
@@ -39,7 +39,7 @@
 //! object, which no model is, is `volpath`'s.
 
 pub use crate::probe::{
-    ChordHits, DEFAULT_PROBE_ENERGY, ProbeRadii, Sampler, Scratch, probe_radii,
+    ChordHits, ProbeRadii, Sampler, Scratch, default_probe_energy, probe_radii,
 };
 
 use super::{
@@ -48,6 +48,7 @@ use super::{
 };
 use crate::Error;
 use crate::frame::Frame;
+use crate::integrators::options::{PROBE_ENERGY, declared};
 use crate::progress::Progress;
 use crate::rng::{Stream, rng};
 use rayon::prelude::*;
@@ -63,15 +64,7 @@ const OPTIONS: [OptionSpec; 2] = [
         kind: OptionKind::Value,
         values: &[],
     },
-    OptionSpec {
-        name: "probe-energy",
-        value_name: "F",
-        default: "0.9999",
-        help: "Fraction of each channel's profile energy inside its probe sphere, in (0, 1); the \
-               energy beyond the largest sphere is never sampled (stat probe_missed_energy)",
-        kind: OptionKind::Value,
-        values: &[],
-    },
+    PROBE_ENERGY,
 ];
 
 /// The registry entry.
@@ -100,15 +93,16 @@ pub struct PathTrace {
     /// BSSRDF samples per G-buffer sample (≥ 1).
     pub spp: u32,
     /// Fraction of each channel's profile energy inside its probe sphere, in (0, 1) (default
-    /// [`DEFAULT_PROBE_ENERGY`]); see the module docs for the bias it leaves.
+    /// [`default_probe_energy`]); see the module docs for the bias it leaves.
     pub probe_energy: f64,
 }
 
 impl Default for PathTrace {
+    /// The declared defaults of `--spp` and `--probe-energy`.
     fn default() -> Self {
         PathTrace {
-            spp: 16,
-            probe_energy: DEFAULT_PROBE_ENERGY,
+            spp: declared(&OPTIONS, "spp"),
+            probe_energy: declared(&OPTIONS, "probe-energy"),
         }
     }
 }

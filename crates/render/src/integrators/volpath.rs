@@ -161,14 +161,9 @@ pub struct VolPath {
 }
 
 impl Default for VolPath {
+    /// The settings of the declared defaults of [`OPTIONS`].
     fn default() -> Self {
-        VolPath {
-            spp: 64,
-            boundary: Boundary::Dielectric,
-            g: None,
-            max_events: None,
-            scattering: Scattering::All,
-        }
+        crate::integrators::options::from_declared(METHOD.name, VolPath::from_options)
     }
 }
 

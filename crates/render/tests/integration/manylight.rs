@@ -35,7 +35,7 @@ fn agrees_with_brute_force_within_its_intervals() {
     let frame = Frame::prepare(&s, settings.seed);
     let reference = brute_force_sphere(&s, &frame);
     let eps = 0.02;
-    let m = integrators::build("manylight", &MethodOptions::new().with("eps", eps)).unwrap();
+    let m = integrators::build("manylight", &MethodOptions::new().with("rel-error", eps)).unwrap();
     let out = render(&s, m.as_ref(), &settings, &NoProgress).unwrap();
     let se = out.std_error.as_ref().unwrap();
     let triplets = out.layer("triplets").unwrap();
@@ -125,7 +125,7 @@ subdivisions = 0
     let reference = render(&s, pt.as_ref(), &settings, &NoProgress).unwrap();
     let pt_se = reference.std_error.as_ref().unwrap();
     let eps = 0.01;
-    let m = integrators::build("manylight", &MethodOptions::new().with("eps", eps)).unwrap();
+    let m = integrators::build("manylight", &MethodOptions::new().with("rel-error", eps)).unwrap();
     let out = render(&s, m.as_ref(), &settings, &NoProgress).unwrap();
     let se = out.std_error.as_ref().unwrap();
     let (ref_mean, ref_se) = image_mean(&reference.subsurface, Some(pt_se), &reference.subsurface);
@@ -171,7 +171,7 @@ subdivisions = 0
     let eelc = integrators::build(
         "eelc",
         &MethodOptions::new()
-            .with("eps", 0.01)
+            .with("rel-error", 0.01)
             .with("irradiance-points", 256),
     )
     .unwrap();
@@ -187,7 +187,9 @@ fn caps_are_reported_and_hold() {
     let s = scene("sphere", 12, 9);
     let m = integrators::build(
         "manylight",
-        &MethodOptions::new().with("eps", 0).with("max-triplets", 40),
+        &MethodOptions::new()
+            .with("rel-error", 0)
+            .with("max-triplets", 40),
     )
     .unwrap();
     let out = render(&s, m.as_ref(), &RenderSettings::default(), &NoProgress).unwrap();
@@ -223,7 +225,7 @@ fn directional_dipole_and_bad_options_are_clear_errors() {
         "{err}"
     );
     for (k, v) in [
-        ("eps", "-1"),
+        ("rel-error", "-1"),
         ("alpha", "1"),
         ("selection", "random"),
         ("vpls", "0"),
@@ -321,7 +323,7 @@ fn every_radial_model_and_light_kind_of_picnic_renders() {
     }
     let m = integrators::build(
         "manylight",
-        &MethodOptions::new().with("eps", 0.1).with("vpls", 64),
+        &MethodOptions::new().with("rel-error", 0.1).with("vpls", 64),
     )
     .unwrap();
     let out = render(&s, m.as_ref(), &RenderSettings::default(), &NoProgress).unwrap();
@@ -610,11 +612,12 @@ fn bounce_vpls_carry_the_reflected_power() {
         }
     }
     // Off by default; on, the integrator's light tree holds them and the image brightens.
-    let m0 = integrators::build("manylight", &MethodOptions::new().with("eps", 0.05)).unwrap();
+    let m0 =
+        integrators::build("manylight", &MethodOptions::new().with("rel-error", 0.05)).unwrap();
     let m1 = integrators::build(
         "manylight",
         &MethodOptions::new()
-            .with("eps", 0.05)
+            .with("rel-error", 0.05)
             .with("bounce-vpls", 2000),
     )
     .unwrap();
@@ -674,11 +677,12 @@ fn baselines_agree_with_manylight_within_statistical_error() {
         }
     }
     for (s, points, uniform) in [(&wide, 2048, true), (&base, 1024, false)] {
-        let ml = integrators::build("manylight", &MethodOptions::new().with("eps", 0.005)).unwrap();
+        let ml = integrators::build("manylight", &MethodOptions::new().with("rel-error", 0.005))
+            .unwrap();
         let reference = render(s, ml.as_ref(), &settings, &NoProgress).unwrap();
         for (method, eps) in [("mdlc", 0.01), ("eelc", 0.02)] {
             let mut o = MethodOptions::new()
-                .with("eps", eps)
+                .with("rel-error", eps)
                 .with("irradiance-points", points);
             if uniform {
                 o = o.with("uniform-points", "");
@@ -745,7 +749,8 @@ fn baselines_terminate_on_shadowed_and_black_pixels() {
             );
             // The pair cap holds, is counted and warned about (ε = 0 never converges).
             let capped =
-                integrators::build(method, &o.clone().with("eps", 0).with("max-pairs", 5)).unwrap();
+                integrators::build(method, &o.clone().with("rel-error", 0).with("max-pairs", 5))
+                    .unwrap();
             let c = render(&s, capped.as_ref(), &settings, &NoProgress).unwrap();
             let cstat = |n: &str| c.stats.iter().find(|s| s.name == n).unwrap().value;
             assert!(c.layer("pairs").unwrap().iter().all(|p| p[0] <= 5.0));
@@ -804,7 +809,7 @@ fn baselines_are_bit_identical_across_thread_counts() {
 fn baselines_refuse_bad_options_unsupported_models_and_textures() {
     for method in ["mdlc", "eelc"] {
         for (k, v) in [
-            ("eps", "-1"),
+            ("rel-error", "-1"),
             ("irradiance-points", "0"),
             ("irradiance-points", "2000000"),
             ("irradiance-points", "many"),

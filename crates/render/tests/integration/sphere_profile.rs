@@ -110,7 +110,7 @@ fn every_method_takes_the_ball_profile() {
         pt[0],
         flat[0]
     );
-    let many = MethodOptions::new().with("eps", 0.1).with("vpls", 64);
+    let many = MethodOptions::new().with("rel-error", 0.1).with("vpls", 64);
     let (exact_small, _) = mean(&sphere_at(keys, 10), "exact", MethodOptions::new(), 3);
     let cases = [
         ("exact", MethodOptions::new(), 24, pt),

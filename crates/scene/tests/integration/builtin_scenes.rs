@@ -244,3 +244,52 @@ fn builtin_shadow_edges() {
         }
     }
 }
+
+/// `load_named`, as `sss render SCENE` and Python's `load_file` take a scene: a built-in name
+/// when no such file exists, else the file; a name that is neither lists the built-in scenes;
+/// a missing mesh names the caller's hint and `SSS_MESH_DIR`.
+#[test]
+fn scenes_by_name_or_file_with_the_callers_hint() {
+    let s = sss_scene::load_named("slab", &[], "HINT").unwrap();
+    assert_eq!(s.name, "slab");
+    let file = scenes_dir().join("slab.toml");
+    let from_file = sss_scene::load_named(file.to_str().unwrap(), &[], "HINT").unwrap();
+    assert_eq!(from_file.path.as_deref(), Some(file.as_path()));
+    assert!(s.path.is_none());
+
+    let e = sss_scene::load_named("no-such-scene", &[], "HINT").unwrap_err();
+    assert_eq!(e.kind, SceneErrorKind::Io);
+    let names: Vec<&str> = BUILTIN_SCENES.iter().map(|(n, _)| *n).collect();
+    assert!(
+        e.message.ends_with(&format!(
+            "nor is it a built-in scene ({})",
+            names.join(", ")
+        )),
+        "{e}"
+    );
+    assert!(!e.message.contains("HINT"), "{e}");
+
+    let dir = std::env::temp_dir().join(format!("sss-load-named-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("s.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\nposition = [0, 0, 4]\ntarget = [0, 0, 0]\nfov = 30\nresolution = [8, 8]\n\
+         [[lights]]\ntype = \"point\"\nposition = [0, 4, 4]\nintensity = 1\n\
+         [materials.m]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\
+         [[objects]]\nmaterial = \"m\"\nshape = \"mesh\"\nfile = \"missing.obj\"\n",
+    )
+    .unwrap();
+    let e =
+        sss_scene::load_named(scene.to_str().unwrap(), &[dir.join("extra")], "HINT").unwrap_err();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(e.kind, SceneErrorKind::MeshNotFound, "{e}");
+    assert!(
+        e.message
+            .ends_with("; add a mesh directory with HINT or the SSS_MESH_DIR environment variable"),
+        "{e}"
+    );
+    // The caller's directories come before the environment's.
+    let opts = LoadOptions::with_dirs(&[PathBuf::from("first")]);
+    assert_eq!(opts.mesh_dirs[0], PathBuf::from("first"));
+}

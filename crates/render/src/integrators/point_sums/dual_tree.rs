@@ -41,7 +41,7 @@ use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
 use crate::integrators::options::{
-    MAX_SAMPLES, SOLID_ANGLE_EPS, SPACING, eps_option, sample_settings,
+    MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
 };
 use crate::integrators::{
     Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
@@ -60,7 +60,7 @@ use sss_scene::Scene;
 pub const OPTIONS: [OptionSpec; 4] = [
     SPACING,
     MAX_SAMPLES,
-    SOLID_ANGLE_EPS,
+    SOLID_ANGLE,
     OptionSpec {
         name: "rho",
         value_name: "R",
@@ -80,8 +80,8 @@ pub const METHOD: Method = Method {
     options: &OPTIONS,
     build: |o| Ok(Box::new(DualTree::from_options(o)?)),
     sweep: Sweep {
-        option: "eps",
-        label: "eps",
+        option: "solid-angle",
+        label: "solid_angle",
         values: eps_sweep,
     },
     converges_to: Converges::Model,
@@ -102,8 +102,8 @@ impl Default for DualTree {
     fn default() -> Self {
         DualTree {
             irradiance: IrradianceSettings::default(),
-            eps: 0.05,
-            rho: 0.75,
+            eps: declared(&OPTIONS, "solid-angle"),
+            rho: declared(&OPTIONS, "rho"),
         }
     }
 }
@@ -119,7 +119,7 @@ impl DualTree {
         }
         Ok(DualTree {
             irradiance: sample_settings(o)?,
-            eps: eps_option(o, &OPTIONS)?,
+            eps: eps_option(o, &OPTIONS, "solid-angle")?,
             rho,
         })
     }

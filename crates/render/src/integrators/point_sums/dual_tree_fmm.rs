@@ -110,7 +110,7 @@ use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
 use crate::integrators::options::{
-    MAX_SAMPLES, SOLID_ANGLE_EPS, SPACING, eps_option, sample_settings,
+    MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
 };
 use crate::integrators::{
     Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep, add_scaled,
@@ -132,7 +132,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 pub const OPTIONS: [OptionSpec; 6] = [
     SPACING,
     MAX_SAMPLES,
-    SOLID_ANGLE_EPS,
+    SOLID_ANGLE,
     OptionSpec {
         name: "px-ratio",
         value_name: "K",
@@ -170,8 +170,8 @@ pub const METHOD: Method = Method {
     options: &OPTIONS,
     build: |o| Ok(Box::new(DualTreeFmm::from_options(o)?)),
     sweep: Sweep {
-        option: "eps",
-        label: "eps",
+        option: "solid-angle",
+        label: "solid_angle",
         values: eps_sweep,
     },
     converges_to: Converges::Model,
@@ -196,10 +196,10 @@ impl Default for DualTreeFmm {
     fn default() -> Self {
         DualTreeFmm {
             irradiance: IrradianceSettings::default(),
-            eps: 0.05,
-            px_ratio: 4.0,
-            order: 2,
-            cap_rho: 0.0,
+            eps: declared(&OPTIONS, "solid-angle"),
+            px_ratio: declared(&OPTIONS, "px-ratio"),
+            order: declared(&OPTIONS, "expansion-order"),
+            cap_rho: declared(&OPTIONS, "cap-rho"),
         }
     }
 }
@@ -227,7 +227,7 @@ impl DualTreeFmm {
         }
         Ok(DualTreeFmm {
             irradiance: sample_settings(o)?,
-            eps: eps_option(o, &OPTIONS)?,
+            eps: eps_option(o, &OPTIONS, "solid-angle")?,
             px_ratio,
             order,
             cap_rho,

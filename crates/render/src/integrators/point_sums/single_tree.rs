@@ -22,7 +22,7 @@ use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
 use crate::integrators::options::{
-    MAX_SAMPLES, SOLID_ANGLE_EPS, SPACING, eps_option, sample_settings,
+    MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
 };
 use crate::integrators::{
     Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep, add_scaled, add_weighted,
@@ -38,7 +38,7 @@ use sss_hierarchy::IrradianceTree;
 use sss_scene::Scene;
 
 /// The options: the irradiance-sample options and ε.
-pub const OPTIONS: [OptionSpec; 3] = [SPACING, MAX_SAMPLES, SOLID_ANGLE_EPS];
+pub const OPTIONS: [OptionSpec; 3] = [SPACING, MAX_SAMPLES, SOLID_ANGLE];
 
 /// The registry entry.
 pub const METHOD: Method = Method {
@@ -47,8 +47,8 @@ pub const METHOD: Method = Method {
     options: &OPTIONS,
     build: |o| Ok(Box::new(SingleTree::from_options(o)?)),
     sweep: Sweep {
-        option: "eps",
-        label: "eps",
+        option: "solid-angle",
+        label: "solid_angle",
         values: eps_sweep,
     },
     converges_to: Converges::Model,
@@ -67,7 +67,7 @@ impl Default for SingleTree {
     fn default() -> Self {
         SingleTree {
             irradiance: IrradianceSettings::default(),
-            eps: 0.05,
+            eps: declared(&OPTIONS, "solid-angle"),
         }
     }
 }
@@ -77,7 +77,7 @@ impl SingleTree {
     pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
         Ok(SingleTree {
             irradiance: sample_settings(o)?,
-            eps: eps_option(o, &OPTIONS)?,
+            eps: eps_option(o, &OPTIONS, "solid-angle")?,
         })
     }
 }

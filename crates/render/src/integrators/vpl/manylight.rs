@@ -39,7 +39,8 @@
 //! "Dark pixels"). A pilot estimates [`PILOT_PIXELS`] seeded translucent pixels at
 //! ε = [`PILOT_EPS`] (stage `floor_pilot`); the 90th percentile of their luminances is the
 //! frame's bright level L, and every estimate also stops once ΔI < ε · `dark_floor` · L
-//! (default [`DEFAULT_DARK_FLOOR`], stat `pixels_floor`). Where εÎ is above that the floor
+//! (default: the declared `--dark-floor`, 10⁻⁶, about 20 stops below L, darker than any display
+//! or tone curve shows; stat `pixels_floor`). Where εÎ is above that the floor
 //! never binds and the estimate is bit-identical to the one without it.
 //!
 //! **Indirect light** is off by default (renders stay comparable with `exact` and
@@ -50,16 +51,18 @@
 //! textures (the estimator's irradiance has no texture factor).
 
 pub use super::{
-    BRIGHT_QUANTILE, DEFAULT_DARK_FLOOR, MIN_TRIPLETS, ManyLight, PILOT_EPS, PILOT_MAX_TRIPLETS,
-    PILOT_PIXELS, PROFILE_TOLERANCE, PixelEstimate, PixelEstimator, PixelResult, SELECTIONS,
-    bright_level, parse_selection,
+    BRIGHT_QUANTILE, MIN_TRIPLETS, ManyLight, PILOT_EPS, PILOT_MAX_TRIPLETS, PILOT_PIXELS,
+    PROFILE_TOLERANCE, PixelEstimate, PixelEstimator, PixelResult, SELECTIONS, bright_level,
+    parse_selection,
 };
 
 use super::{eps_sweep, estimator_options, pixel_list, pixel_result};
 use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
-use crate::integrators::options::{ALPHA, DARK_FLOOR, MAX_TRIPLETS, RELATIVE_EPS, SELECTION, VPLS};
+use crate::integrators::options::{
+    ALPHA, DARK_FLOOR, MAX_TRIPLETS, REL_ERROR, SELECTION, VPLS, declared,
+};
 use crate::integrators::{
     Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
 };
@@ -71,7 +74,7 @@ use sss_scene::Scene;
 
 /// The options of `manylight`.
 pub const OPTIONS: [OptionSpec; 9] = [
-    RELATIVE_EPS,
+    REL_ERROR,
     ALPHA,
     SELECTION,
     VPLS,
@@ -96,7 +99,7 @@ pub const OPTIONS: [OptionSpec; 9] = [
         name: "paper-estimate",
         value_name: "",
         default: "",
-        help: "Report the samples the stopping test saw (the paper's estimator: biased low at loose eps, about 1 % at 0.1) instead of new samples of the final triplets (unbiased, about half again the samples)",
+        help: "Report the samples the stopping test saw (the paper's estimator: biased low at loose rel-error, about 1 % at 0.1) instead of new samples of the final triplets (unbiased, about half again the samples)",
         kind: OptionKind::Flag,
         values: &[],
     },
@@ -106,16 +109,40 @@ pub const OPTIONS: [OptionSpec; 9] = [
 /// The registry entry.
 pub const METHOD: Method = Method {
     name: "manylight",
-    about: "Many-light SSS: VPL x triangle x pixel clusters refined until the Student-t interval is below eps (Nabata & Iwasaki 2021)",
+    about: "Many-light SSS: VPL x triangle x pixel clusters refined until the Student-t interval is below rel-error (Nabata & Iwasaki 2021)",
     options: &OPTIONS,
     build: |o| Ok(Box::new(ManyLight::from_options(o)?)),
     sweep: Sweep {
-        option: "eps",
-        label: "eps",
+        option: "rel-error",
+        label: "rel_error",
         values: eps_sweep,
     },
     converges_to: Converges::Model,
 };
+
+impl Default for ManyLight {
+    /// The declared defaults of [`OPTIONS`] (`--paper-estimate` off: a fresh final
+    /// estimate), the frame's own VPL seed and the first estimator stream.
+    fn default() -> Self {
+        let selection: String = declared(&OPTIONS, "selection");
+        ManyLight {
+            eps: declared(&OPTIONS, "rel-error"),
+            alpha: declared(&OPTIONS, "alpha"),
+            selection: match parse_selection(&selection) {
+                Ok(s) => s,
+                Err(e) => panic!("the declared default of --selection: {e}"),
+            },
+            vpls: declared(&OPTIONS, "vpls"),
+            max_triplets: declared(&OPTIONS, "max-triplets"),
+            max_splits: declared(&OPTIONS, "max-splits"),
+            bounce_paths: declared(&OPTIONS, "bounce-vpls"),
+            vpl_seed: None,
+            stream: 0,
+            fresh_final: true,
+            dark_floor: declared(&OPTIONS, "dark-floor"),
+        }
+    }
+}
 
 impl ManyLight {
     /// The settings `options` describe (errors name the flag).
@@ -177,7 +204,7 @@ impl Integrator for ManyLight {
 
     fn describe(&self) -> String {
         format!(
-            "eps {}, alpha {}, {} selection, {} VPLs per area/environment light, {}",
+            "rel-error {}, alpha {}, {} selection, {} VPLs per area/environment light, {}",
             self.eps,
             self.alpha,
             match self.selection {

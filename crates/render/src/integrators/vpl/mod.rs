@@ -289,33 +289,8 @@ pub struct ManyLight {
     /// estimator, biased low by the sequential stop at loose ε; see `sss_manylight::estimator`).
     pub fresh_final: bool,
     /// The dark-pixel floor F (≥ 0): a pixel also stops once ΔI < ε · F · the frame's bright
-    /// level (see [`DEFAULT_DARK_FLOOR`]); 0 keeps the paper's purely relative criterion.
+    /// level (`--dark-floor`, see [`crate::integrators::options::DARK_FLOOR`]); 0 keeps the paper's purely relative criterion.
     pub dark_floor: f64,
-}
-
-/// The default dark-pixel floor: 10⁻⁶, about 20 stops below the frame's bright level, darker
-/// than any display or tone curve shows. Pixels that dark (in a point-lit head's own shadow,
-/// 10⁻⁸ of the median) otherwise refine to the triplet cap for a relative error nobody sees:
-/// the triplets' bounds ignore visibility, so the refinement splits the shadowed clusters next
-/// to the pixel, whose samples are all 0, long before the faint far ones that carry its value.
-pub const DEFAULT_DARK_FLOOR: f64 = 1e-6;
-
-impl Default for ManyLight {
-    fn default() -> Self {
-        ManyLight {
-            eps: 0.02,
-            alpha: 0.95,
-            selection: Selection::BssrdfAware,
-            vpls: 1024,
-            max_triplets: 200_000,
-            max_splits: 200_000,
-            bounce_paths: 0,
-            vpl_seed: None,
-            stream: 0,
-            fresh_final: true,
-            dark_floor: DEFAULT_DARK_FLOOR,
-        }
-    }
 }
 
 pub use crate::integrators::options::SELECTIONS;
@@ -335,7 +310,7 @@ pub fn parse_selection(s: &str) -> Result<Selection, Error> {
 /// The ε values `cargo xtask compare` sweeps for the many-light estimator's methods, loosest
 /// (cheapest) first. Not the paper's 0.02 in the default run: on the slab (a wall's shadow 2
 /// diffusion lengths deep) ε = 0.02 takes 4 minutes of the 20; finer ε goes with
-/// `cargo xtask compare --manylight` and `sss render --eps`.
+/// `cargo xtask compare --manylight` and `sss render --rel-error`.
 pub fn eps_sweep(quick: bool) -> Vec<f64> {
     if quick {
         vec![0.1, 0.05]
@@ -368,7 +343,7 @@ pub(crate) fn estimator_options(
         )));
     }
     Ok(ManyLight {
-        eps: eps_option(o, options)?,
+        eps: eps_option(o, options, "rel-error")?,
         alpha: alpha_option(o, options)?,
         selection: parse_selection(&o.get::<String>(options, "selection")?)?,
         vpls,

@@ -66,7 +66,7 @@ use sss_util::luminance;
 /// The options of `sparse-manylight`.
 pub const OPTIONS: [OptionSpec; 9] = [
     OptionSpec {
-        name: "eps",
+        name: "rel-error",
         value_name: "E",
         default: "0.02",
         help: "Relative error threshold of the output: every pixel, estimated or reconstructed, has its interval below E times its value",
@@ -95,7 +95,7 @@ pub const OPTIONS: [OptionSpec; 9] = [
         name: "estimate-share",
         value_name: "F",
         default: "0.8",
-        help: "The lattice points the reconstruction reads are estimated at F times eps, leaving the rest to the reconstruction (in (0, 1])",
+        help: "The lattice points the reconstruction reads are estimated at F times rel-error, leaving the rest to the reconstruction (in (0, 1])",
         kind: OptionKind::Value,
         values: &[],
     },
@@ -111,8 +111,8 @@ pub const METHOD: Method = Method {
     options: &OPTIONS,
     build: |o| Ok(Box::new(SparseManyLight::from_options(o)?)),
     sweep: Sweep {
-        option: "eps",
-        label: "eps",
+        option: "rel-error",
+        label: "rel_error",
         // At the default run's frame sizes (160 × 120) s_p is above 1/4 on nearly every
         // pixel, so no cell is eligible and the method repeats `manylight` (same values, 0.2 s
         // more for s_p): one point in the full run shows it, none in `--quick` (it cost the
@@ -151,15 +151,9 @@ pub struct SparseManyLight {
 }
 
 impl Default for SparseManyLight {
+    /// The settings of the declared defaults of [`OPTIONS`].
     fn default() -> Self {
-        SparseManyLight {
-            estimator: ManyLight::default(),
-            eps: 0.02,
-            estimate_share: 0.8,
-            rho: 1.0,
-            max_cell: 32,
-            rate_scale: 1.0,
-        }
+        crate::integrators::options::from_declared(METHOD.name, SparseManyLight::from_options)
     }
 }
 
@@ -170,7 +164,7 @@ impl SparseManyLight {
         let eps = estimator.eps;
         if !(eps > 0.0) {
             return Err(Error::Input(format!(
-                "--eps must be > 0 for sparse-manylight (its cells are accepted by it), got {eps}"
+                "--rel-error must be > 0 for sparse-manylight (its cells are accepted by it), got {eps}"
             )));
         }
         let rho: f64 = o.get(&OPTIONS, "rho")?;
@@ -659,7 +653,7 @@ impl Integrator for SparseManyLight {
 
     fn describe(&self) -> String {
         format!(
-            "eps {} (lattice points at {}), alpha {}, rho {}, cells up to {} px, {} VPLs per area/environment light",
+            "rel-error {} (lattice points at {}), alpha {}, rho {}, cells up to {} px, {} VPLs per area/environment light",
             self.eps,
             self.eps * self.estimate_share,
             self.estimator.alpha,

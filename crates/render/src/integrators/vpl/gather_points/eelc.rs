@@ -19,8 +19,7 @@ use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
 use crate::integrators::options::{
-    ALPHA, IRRADIANCE_POINTS, MAX_PAIRS, RELATIVE_EPS, UNIFORM_POINTS, VPLS, alpha_option,
-    eps_option,
+    ALPHA, IRRADIANCE_POINTS, MAX_PAIRS, REL_ERROR, UNIFORM_POINTS, VPLS, alpha_option, eps_option,
 };
 use crate::integrators::vpl::{MIN_TRIPLETS, PixelResult};
 use crate::integrators::{Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep};
@@ -28,9 +27,9 @@ use crate::progress::Progress;
 use sss_manylight::{EelcEstimator, EelcSettings, GatherTree, PixelEstimate, StudentT, Visibility};
 use sss_scene::Scene;
 
-/// The options of `eelc` (`--eps`, `--alpha` and `--vpls` as `manylight`'s).
+/// The options of `eelc` (`--rel-error`, `--alpha` and `--vpls` as `manylight`'s).
 pub const OPTIONS: [OptionSpec; 6] = [
-    RELATIVE_EPS,
+    REL_ERROR,
     ALPHA,
     IRRADIANCE_POINTS,
     UNIFORM_POINTS,
@@ -64,19 +63,16 @@ pub struct Eelc {
 }
 
 impl Default for Eelc {
+    /// The settings of the declared defaults of [`OPTIONS`].
     fn default() -> Self {
-        Eelc {
-            eps: 0.02,
-            alpha: 0.95,
-            points: PointOptions::default(),
-        }
+        crate::integrators::options::from_declared(METHOD.name, Eelc::from_options)
     }
 }
 
 impl Eelc {
     /// The settings `options` describe (errors name the flag).
     pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
-        let eps = eps_option(o, &OPTIONS)?;
+        let eps = eps_option(o, &OPTIONS, "rel-error")?;
         let alpha = alpha_option(o, &OPTIONS)?;
         Ok(Eelc {
             eps,
@@ -152,7 +148,7 @@ impl Integrator for Eelc {
 
     fn describe(&self) -> String {
         format!(
-            "eps {}, alpha {}, {}",
+            "rel-error {}, alpha {}, {}",
             self.eps,
             self.alpha,
             self.points.describe()

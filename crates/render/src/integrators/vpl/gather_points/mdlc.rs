@@ -29,7 +29,7 @@ use sss_scene::Scene;
 /// The options of `mdlc`.
 pub const OPTIONS: [OptionSpec; 5] = [
     OptionSpec {
-        name: "eps",
+        name: "rel-error",
         value_name: "E",
         default: "0.02",
         help: "Lightcuts' relative threshold: refine the cut until every cluster pair's error bound is below E times the pixel's estimate (Weber's law; the paper uses 0.02)",
@@ -71,18 +71,16 @@ pub struct Mdlc {
 }
 
 impl Default for Mdlc {
+    /// The settings of the declared defaults of [`OPTIONS`].
     fn default() -> Self {
-        Mdlc {
-            eps: 0.02,
-            points: PointOptions::default(),
-        }
+        crate::integrators::options::from_declared(METHOD.name, Mdlc::from_options)
     }
 }
 
 impl Mdlc {
     /// The settings `options` describe (errors name the flag).
     pub fn from_options(o: &MethodOptions) -> Result<Self, Error> {
-        let eps = eps_option(o, &OPTIONS)?;
+        let eps = eps_option(o, &OPTIONS, "rel-error")?;
         Ok(Mdlc {
             eps,
             points: PointOptions::from_options(o, &OPTIONS)?,
@@ -143,7 +141,7 @@ impl Integrator for Mdlc {
     }
 
     fn describe(&self) -> String {
-        format!("eps {}, {}", self.eps, self.points.describe())
+        format!("rel-error {}, {}", self.eps, self.points.describe())
     }
 
     fn layer_names(&self) -> &'static [&'static str] {

@@ -54,9 +54,9 @@ use super::{
 };
 use crate::Error;
 use crate::frame::Frame;
-use crate::integrators::options::{IRRADIANCE_POINTS, MAX_PAIRS, UNIFORM_POINTS};
+use crate::integrators::options::{IRRADIANCE_POINTS, MAX_PAIRS, UNIFORM_POINTS, VPLS};
 use crate::integrators::{Layer, MethodOptions, OptionSpec, Shaded, Stat, check_radial};
-use crate::probe::{DEFAULT_PROBE_ENERGY, Sampler, Scratch, probe_radii};
+use crate::probe::{Sampler, Scratch, default_probe_energy, probe_radii};
 use crate::progress::Progress;
 use crate::rng::{Stream, rng};
 use crate::vpls::vpl_count;
@@ -99,15 +99,12 @@ pub struct PointOptions {
 }
 
 impl Default for PointOptions {
+    /// The declared defaults of the shared options `--irradiance-points`, `--uniform-points`,
+    /// `--vpls` and `--max-pairs`.
     fn default() -> Self {
-        PointOptions {
-            irradiance_points: 4096,
-            uniform: false,
-            vpls: 1024,
-            max_pairs: 200_000,
-            vpl_seed: None,
-            stream: 0,
-        }
+        crate::integrators::options::from_declared("the gather-point options", |o| {
+            PointOptions::from_options(o, &[IRRADIANCE_POINTS, UNIFORM_POINTS, VPLS, MAX_PAIRS])
+        })
     }
 }
 
@@ -283,7 +280,7 @@ fn estimate_pixels<E: PixelEstimator>(
     let (radii, missed) = if opts.uniform {
         (frame.shading.iter().map(|_| None).collect(), 0.0)
     } else {
-        probe_radii(&frame.shading, DEFAULT_PROBE_ENERGY)
+        probe_radii(&frame.shading, default_probe_energy())
     };
     // Shadow rays from the gather point to the VPL, as `manylight`'s.
     let visibility = shadow_test(frame);

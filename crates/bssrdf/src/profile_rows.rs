@@ -1,37 +1,34 @@
-//! Radial profiles R_d(r) of a model or of the Monte Carlo reference, as a table: the library
-//! behind `sss profile`.
+//! Radial profiles R_d(r) of a model or of the Monte Carlo reference, evaluated into rows: what
+//! `sss profile` prints and the Python `Model.profile` returns.
 //!
-//! [`ProfileRequest`] says what to compute, [`compute`] evaluates it into a [`ProfileTable`],
-//! which writes itself as CSV ([`ProfileTable::write_csv`]) and draws itself
-//! ([`ProfileTable::plot`]).
+//! [`ProfileRequest`] says what to compute (a [`ProfileModel`], a [`MediumSpec`], the radii or
+//! bins), [`compute`] evaluates it into [`ProfileRows`], which writes itself as CSV
+//! ([`ProfileRows::write_csv`]). [`check_budget`] refuses a request whose rows would not fit
+//! in memory before anything is allocated.
 //!
 //! ```
-//! use sss_cli::profile_table::{compute, MediumSpec, ProfileModel, ProfileRequest};
+//! use sss_bssrdf::MediumSpec;
+//! use sss_bssrdf::profile_rows::{compute, ProfileModel, ProfileRequest};
 //! let req = ProfileRequest {
 //!     steps: 4,
 //!     ..ProfileRequest::new(ProfileModel::Pbd, MediumSpec::Preset("skin1".into()), 5.0)
 //! };
-//! let table = compute(&req, &|_| {})?;
+//! let rows = compute(&req, &|_| {})?;
 //! let mut csv = Vec::new();
-//! table.write_csv(&mut csv).unwrap();
+//! rows.write_csv(&mut csv).unwrap();
 //! assert!(String::from_utf8(csv).unwrap().starts_with("# total_diffuse_reflectance="));
-//! # Ok::<(), sss_render::Error>(())
+//! # Ok::<(), sss_bssrdf::BssrdfError>(())
 //! ```
 
-use crate::Error;
-use crate::medium_spec::medium_label;
-pub use crate::medium_spec::{MediumSpec, build_medium};
-use sss_bssrdf::monte_carlo::{self, BinSpacing, McConfig};
-use sss_bssrdf::{ModelKind, Rgb, make_model};
-use sss_plot::{CHANNEL_COLORS, ErrorStyle, PlotError, Series, line_plot};
+use crate::monte_carlo::{self, BinSpacing, McConfig};
+use crate::{BssrdfError, MediumSpec, ModelKind, Rgb, make_model};
 use std::io::Write;
-use std::path::Path;
 
 /// Largest accepted `steps` (rows) for an analytic model, to keep the output bounded.
 pub const MAX_STEPS: usize = 10_000_000;
 
 /// What produces the profile: one of the models, or the Monte Carlo reference.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ProfileModel {
     /// Jensen et al. 2001.
     StandardDipole,
@@ -50,6 +47,17 @@ pub enum ProfileModel {
 }
 
 impl ProfileModel {
+    /// Every variant, in the order `sss profile --help` lists them.
+    pub const ALL: [ProfileModel; 7] = [
+        ProfileModel::StandardDipole,
+        ProfileModel::BetterDipole,
+        ProfileModel::DirectionalDipole,
+        ProfileModel::Pbd,
+        ProfileModel::Burley,
+        ProfileModel::McTable,
+        ProfileModel::MonteCarlo,
+    ];
+
     /// The analytic model, or `None` for the Monte Carlo reference.
     pub fn kind(self) -> Option<ModelKind> {
         match self {
@@ -69,6 +77,30 @@ impl ProfileModel {
             Some(k) => k.name(),
             None => "monte-carlo",
         }
+    }
+}
+
+impl std::fmt::Display for ProfileModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ProfileModel {
+    type Err = BssrdfError;
+
+    /// A model by its command-line name ([`ProfileModel::name`]).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        ProfileModel::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<&str> = ProfileModel::ALL.iter().map(|m| m.name()).collect();
+                BssrdfError::InvalidArgument(format!(
+                    "unknown profile model '{s}' (one of: {})",
+                    names.join(", ")
+                ))
+            })
     }
 }
 
@@ -122,7 +154,7 @@ pub struct ProfileRow {
 
 /// A computed profile.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ProfileTable {
+pub struct ProfileRows {
     /// What produced it.
     pub model: ProfileModel,
     /// A short description of the medium (preset name or coefficients).
@@ -177,10 +209,10 @@ pub fn memory_bytes(req: &ProfileRequest) -> u64 {
 
 /// Fails, naming `--steps`, the bytes needed and the budget, when `req` is estimated
 /// ([`memory_bytes`]) to need more than `budget` bytes. Nothing is allocated before.
-pub fn check_budget(req: &ProfileRequest, budget: u64) -> Result<(), Error> {
+pub fn check_budget(req: &ProfileRequest, budget: u64) -> Result<(), BssrdfError> {
     let needed = memory_bytes(req);
     if needed > budget {
-        return Err(Error::Input(format!(
+        return Err(BssrdfError::InvalidArgument(format!(
             "--steps {} ({}) needs about {needed} bytes ({}), over the memory budget of \
              {budget} bytes ({}); lower --steps or raise --max-memory",
             req.steps,
@@ -189,45 +221,49 @@ pub fn check_budget(req: &ProfileRequest, budget: u64) -> Result<(), Error> {
             } else {
                 "rows"
             },
-            sss_render::budget::human(needed),
-            sss_render::budget::human(budget)
+            sss_util::human_bytes(needed),
+            sss_util::human_bytes(budget)
         )));
     }
     Ok(())
 }
 
-fn check_request(req: &ProfileRequest) -> Result<(), Error> {
+fn check_request(req: &ProfileRequest) -> Result<(), BssrdfError> {
     if !(req.r_max.is_finite() && req.r_max > 0.0) {
-        return Err(Error::Input(format!(
+        return Err(BssrdfError::InvalidArgument(format!(
             "--r-max {} must be a finite number of mm > 0",
             req.r_max
         )));
     }
     if req.steps == 0 {
-        return Err(Error::Input("--steps must be at least 1".into()));
+        return Err(BssrdfError::InvalidArgument(
+            "--steps must be at least 1".into(),
+        ));
     }
     match req.model {
         ProfileModel::MonteCarlo => {
             if req.log {
-                return Err(Error::Input(
+                return Err(BssrdfError::InvalidArgument(
                     "--log is not available for --model monte-carlo (its bins are linear over [0, r_max])"
                         .into(),
                 ));
             }
             if req.steps > monte_carlo::MAX_BINS {
-                return Err(Error::Input(format!(
+                return Err(BssrdfError::InvalidArgument(format!(
                     "--steps {} exceeds the Monte Carlo limit of {} bins",
                     req.steps,
                     monte_carlo::MAX_BINS
                 )));
             }
             if req.photons == 0 {
-                return Err(Error::Input("--photons must be at least 1".into()));
+                return Err(BssrdfError::InvalidArgument(
+                    "--photons must be at least 1".into(),
+                ));
             }
         }
         _ => {
             if req.steps > MAX_STEPS {
-                return Err(Error::Input(format!(
+                return Err(BssrdfError::InvalidArgument(format!(
                     "--steps {} exceeds the limit of {MAX_STEPS}",
                     req.steps
                 )));
@@ -237,11 +273,11 @@ fn check_request(req: &ProfileRequest) -> Result<(), Error> {
     Ok(())
 }
 
-fn finite(what: &str, v: f64) -> Result<f64, Error> {
+fn finite(what: &str, v: f64) -> Result<f64, BssrdfError> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(Error::NonFinite(format!(
+        Err(BssrdfError::NonFinite(format!(
             "{what} is {v}, not a finite number (a bug in the model; nothing was printed)"
         )))
     }
@@ -253,17 +289,17 @@ fn finite(what: &str, v: f64) -> Result<f64, Error> {
 pub fn compute(
     req: &ProfileRequest,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<ProfileTable, Error> {
+) -> Result<ProfileRows, BssrdfError> {
     check_request(req)?;
-    let medium = build_medium(&req.medium, req.eta)?;
-    let medium_label = medium_label(&req.medium, &medium);
-    if req.model == ProfileModel::McTable && !sss_bssrdf::mc_table::eta_in_range(medium.eta()) {
-        return Err(Error::Input(format!(
+    let medium = req.medium.medium(req.eta)?;
+    let medium_label = req.medium.label(&medium);
+    if req.model == ProfileModel::McTable && !crate::mc_table::eta_in_range(medium.eta()) {
+        return Err(BssrdfError::InvalidArgument(format!(
             "--eta {} is outside the range of the mc-table tables (η from {} to {}); use \
              another model for this medium",
             medium.eta(),
-            sss_bssrdf::mc_table::ETAS[0],
-            sss_bssrdf::mc_table::ETAS[sss_bssrdf::mc_table::ETAS.len() - 1]
+            crate::mc_table::ETAS[0],
+            crate::mc_table::ETAS[crate::mc_table::ETAS.len() - 1]
         )));
     }
     let (total, rows) = match req.model.kind() {
@@ -285,7 +321,7 @@ pub fn compute(
                     }
                     Ok(ProfileRow { r, rd, se: None })
                 })
-                .collect::<Result<Vec<_>, Error>>()?;
+                .collect::<Result<Vec<_>, BssrdfError>>()?;
             (total, rows)
         }
         None => {
@@ -315,14 +351,14 @@ pub fn compute(
                         se: Some(se),
                     })
                 })
-                .collect::<Result<Vec<_>, Error>>()?;
+                .collect::<Result<Vec<_>, BssrdfError>>()?;
             for t in mc.total {
                 finite("Monte Carlo total", t)?;
             }
             (mc.total, rows)
         }
     };
-    Ok(ProfileTable {
+    Ok(ProfileRows {
         model: req.model,
         medium_label,
         total,
@@ -330,7 +366,7 @@ pub fn compute(
     })
 }
 
-impl ProfileTable {
+impl ProfileRows {
     /// True when the rows carry standard errors (Monte Carlo).
     pub fn has_se(&self) -> bool {
         self.rows.iter().any(|r| r.se.is_some())
@@ -358,30 +394,6 @@ impl ProfileTable {
             writeln!(w)?;
         }
         Ok(())
-    }
-
-    /// Draws the three channels on a log y axis (log x too when `log_x`), Monte Carlo with
-    /// its standard errors as a band, to `path` (`.png` or `.svg`).
-    pub fn plot(&self, path: &Path, log_x: bool) -> Result<(), PlotError> {
-        let names = ["red", "green", "blue"];
-        let series: Vec<Series> = (0..3)
-            .map(|ch| {
-                let points = self.rows.iter().map(|r| (r.r, r.rd[ch])).collect();
-                let s = Series::line(names[ch], points).with_color(CHANNEL_COLORS[ch]);
-                if self.has_se() {
-                    let err = self
-                        .rows
-                        .iter()
-                        .map(|r| r.se.map_or(0.0, |se| se[ch]))
-                        .collect();
-                    s.with_errors(err, ErrorStyle::Band)
-                } else {
-                    s
-                }
-            })
-            .collect();
-        let title = format!("Rd(r), {}: {}", self.model.name(), self.medium_label);
-        line_plot(path, &title, "r (mm)", "Rd (1/mm²)", &series, log_x, true)
     }
 }
 
@@ -448,19 +460,18 @@ mod tests {
     }
 
     #[test]
-    fn names_match_the_models() {
-        use clap::ValueEnum;
-        for m in ProfileModel::value_variants() {
-            let pv = m.to_possible_value().unwrap();
-            assert_eq!(pv.get_name(), m.name());
+    fn names_parse_back_and_cover_the_models() {
+        for m in ProfileModel::ALL {
+            assert_eq!(m.name().parse::<ProfileModel>().unwrap(), m);
+            assert_eq!(m.to_string(), m.name());
         }
         for k in ModelKind::ALL {
-            assert!(
-                ProfileModel::value_variants()
-                    .iter()
-                    .any(|m| m.kind() == Some(k))
-            );
+            let m = ProfileModel::ALL.iter().find(|m| m.kind() == Some(k));
+            assert_eq!(m.map(|m| m.name()), Some(k.name()));
         }
+        assert_eq!(ProfileModel::MonteCarlo.kind(), None);
+        let e = "nope".parse::<ProfileModel>().unwrap_err().to_string();
+        assert!(e.contains("'nope'") && e.contains("monte-carlo"), "{e}");
     }
 
     #[test]
@@ -503,7 +514,7 @@ mod tests {
 
     #[test]
     fn csv_layout() {
-        let t = ProfileTable {
+        let t = ProfileRows {
             model: ProfileModel::MonteCarlo,
             medium_label: "x".into(),
             total: [0.5, 0.25, 0.125],
