@@ -2,7 +2,7 @@
 //! `sss-render`.
 
 use sss_bssrdf::MediumSpec;
-use sss_bssrdf::monte_carlo::{self, BinSpacing, McConfig};
+use sss_bssrdf::monte_carlo::{self, BinSpacing, WalkConfig};
 use sss_bssrdf::presets::PRESETS;
 use sss_bssrdf::profile_rows::{ProfileModel, ProfileRequest, compute};
 use sss_bssrdf::{Medium, ModelKind};
@@ -76,7 +76,7 @@ fn monte_carlo_table_is_the_library_simulation() {
     let t = compute(&req, &|_| {}).unwrap();
     let direct = monte_carlo::simulate(
         &Medium::preset("skin2").unwrap(),
-        &McConfig {
+        &WalkConfig {
             photons: 3000,
             seed: 11,
             r_max: 6.0,

@@ -20,7 +20,7 @@
 //! # Ok::<(), sss_bssrdf::BssrdfError>(())
 //! ```
 
-use crate::monte_carlo::{self, BinSpacing, McConfig};
+use crate::monte_carlo::{self, BinSpacing, WalkConfig};
 use crate::{BssrdfError, MediumSpec, ModelKind, Rgb, make_model};
 use std::io::Write;
 
@@ -325,7 +325,7 @@ pub fn compute(
             (total, rows)
         }
         None => {
-            let cfg = McConfig {
+            let cfg = WalkConfig {
                 photons: req.photons,
                 seed: req.seed,
                 r_max: req.r_max,

@@ -58,22 +58,22 @@ mod kernels;
 mod manylight;
 mod output;
 mod profiles;
-mod reference;
 mod scenes;
 mod shard;
 mod subset;
 mod trees;
 mod truth;
+mod walk_reference;
 
 pub use scenes::default_mesh_dirs;
 pub use shard::Shard;
 
 use output::write_atomic;
-use reference::PresetReference;
 use sss_bssrdf::presets::{self, Preset};
 use std::fmt;
 use std::path::PathBuf;
 use std::time::Instant;
+use walk_reference::PresetReference;
 
 /// Presets of `--quick`: a typical translucent material (skin1), a nearly non-absorbing one
 /// (marble) and a strongly absorbing one (ketchup, whose blue channel reflects almost
@@ -414,7 +414,7 @@ pub fn run(config: &Config) -> Result<(), Error> {
     let references = if config.paper_only() {
         Vec::new()
     } else {
-        reference::load_or_compute(config, &presets, &log, &bar)?
+        walk_reference::load_or_compute(config, &presets, &log, &bar)?
     };
     bar.finish_and_clear();
     let ctx = Context {
@@ -465,7 +465,7 @@ fn assemble_report(
         config.photons,
         config.seed,
         config.bins,
-        100.0 * reference::R_MAX_ENERGY,
+        100.0 * walk_reference::R_MAX_ENERGY,
     ));
     if let Some(note) = note {
         s.push_str(note);

@@ -97,7 +97,6 @@ pub mod rng;
 pub mod sampling_rate;
 pub mod shading;
 pub mod volume;
-pub mod vpls;
 
 pub use error::Error;
 /// The scene format (re-exported from `sss-scene`).

@@ -180,6 +180,16 @@ pub fn material_model(t: &Translucent) -> Box<dyn Bssrdf> {
     }
 }
 
+/// The factors that turn R_d and its first two radial derivatives, per mm, into scene units:
+/// 1/u², 1/u³ and 1/u⁴, u the scene units per mm (R_d(r/u)/u² per scene unit², R_d′(r/u)/u³,
+/// R_d″(r/u)/u⁴). The one place the scene-unit factor is written: every method's R_d in scene
+/// units goes through it.
+#[inline]
+pub fn scene_unit_factors(u: f64) -> [f64; 3] {
+    let s0 = 1.0 / (u * u);
+    [s0, s0 / u, s0 / (u * u)]
+}
+
 impl TranslucentShading {
     /// Builds the model of a translucent material named `name`.
     pub fn new(name: &str, t: &Translucent) -> Self {
@@ -243,8 +253,22 @@ impl TranslucentShading {
     pub fn rd_scene(&self, r: f64) -> Rgb {
         let u = self.units_per_mm;
         let rd = self.bssrdf().rd_rgb(r / u);
-        let s = 1.0 / (u * u);
+        let [s, _, _] = scene_unit_factors(u);
         [rd[0] * s, rd[1] * s, rd[2] * s]
+    }
+
+    /// R_d and its first two radial derivatives per channel at scene-unit distance `r`, in
+    /// scene units (R_d(r/u)/u², R_d′(r/u)/u³, R_d″(r/u)/u⁴), from
+    /// [`sss_bssrdf::Bssrdf::rd_derivatives`]: the local expansions of `dual-tree-fmm`.
+    pub fn rd_derivatives_scene(&self, r: f64) -> [[f64; 3]; 3] {
+        let u = self.units_per_mm;
+        let m = self.bssrdf();
+        let x = r / u;
+        let [s0, s1, s2] = scene_unit_factors(u);
+        std::array::from_fn(|c| {
+            let (v, d1, d2) = m.rd_derivatives(c, x);
+            [v * s0, d1 * s1, d2 * s2]
+        })
     }
     /// The point sum Σ_i R_d(‖x − x_i‖) E_i A_i (Jensen & Buhler 2002, Eq. 2, with each
     /// sample's R_d averaged over its disk by [`rd_sample_scene`](Self::rd_sample_scene)) of
@@ -301,8 +325,7 @@ impl TranslucentShading {
         let h = x * (1.0 - (-1.0 / self.disk.per_ln).exp());
         let (tp, tm) = (t(x + h), t(x - h));
         let m = self.bssrdf();
-        let s0 = 1.0 / (u * u);
-        let (s1, s2) = (s0 / u, s0 / (u * u));
+        let [s0, s1, s2] = scene_unit_factors(u);
         let out: [[f64; 3]; 3] = std::array::from_fn(|c| {
             let (v, d1, d2) = m.rd_derivatives(c, x);
             let t1 = (tp[c] - tm[c]) / (2.0 * h);

@@ -413,7 +413,7 @@ fn run_chunk(
 mod tests {
     use super::*;
     use crate::Medium;
-    use crate::monte_carlo::{BinSpacing, McConfig, simulate};
+    use crate::monte_carlo::{BinSpacing, WalkConfig, simulate};
 
     fn config(photons: u64, albedos: Vec<f64>, eta: f64) -> CondensedConfig {
         CondensedConfig {
@@ -443,7 +443,7 @@ mod tests {
             assert_eq!(m.albedo(0), 0.75);
             let mc = simulate(
                 &m,
-                &McConfig {
+                &WalkConfig {
                     photons: c.photons,
                     seed: c.seed,
                     r_max: 6.0,
@@ -490,7 +490,7 @@ mod tests {
         let doubled: Vec<f64> = c.edges.iter().map(|e| 2.0 * e).collect();
         let mc = simulate(
             &m,
-            &McConfig {
+            &WalkConfig {
                 photons: c.photons,
                 seed: c.seed,
                 r_max: doubled[doubled.len() - 1],
@@ -531,7 +531,7 @@ mod tests {
             let m = Medium::from_extinction_albedo([1.0; 3], [0.5; 3], 0.0, eta).unwrap();
             let mc = simulate(
                 &m,
-                &McConfig {
+                &WalkConfig {
                     photons: 40_000,
                     seed: 99,
                     r_max: 6.0,

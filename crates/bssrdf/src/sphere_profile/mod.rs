@@ -50,7 +50,7 @@
 //! ```
 
 use crate::binned::{between_centres, memoized};
-use crate::monte_carlo::{self, BinSpacing, McConfig};
+use crate::monte_carlo::{self, BinSpacing, WalkConfig};
 use crate::radial::RadialTable;
 use crate::{Bssrdf, BssrdfError, Medium, ModelKind};
 use std::collections::HashMap;
@@ -120,7 +120,7 @@ impl SphereDelta {
             };
             let mut channels = [false; 3];
             channels[ch] = true;
-            let cfg = McConfig {
+            let cfg = WalkConfig {
                 photons: photons.max(1),
                 seed: SEED,
                 r_max,

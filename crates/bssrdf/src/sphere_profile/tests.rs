@@ -3,7 +3,7 @@
 //! is the half-space).
 
 use super::*;
-use crate::monte_carlo::{BinSpacing, McConfig, simulate_analog, simulate_sphere};
+use crate::monte_carlo::{BinSpacing, WalkConfig, simulate_analog, simulate_sphere};
 use crate::quadrature::integrate;
 use crate::{Bssrdf, McTableModel, Medium};
 
@@ -11,8 +11,8 @@ fn skin1() -> Medium {
     Medium::new([0.032, 0.17, 0.48], [0.74, 0.88, 1.01], 0.0, 1.3).unwrap()
 }
 
-fn config(photons: u64, r_max: f64, bins: usize) -> McConfig {
-    McConfig {
+fn config(photons: u64, r_max: f64, bins: usize) -> WalkConfig {
+    WalkConfig {
         photons,
         seed: 7,
         r_max,

@@ -14,7 +14,7 @@
 //! the other models in `sampling_at_table_speed.rs`, `models.rs` and `extremes.rs`.
 
 use sss_bssrdf::mc_table::{ETAS, GS, McTable, McTableData, tally_edges};
-use sss_bssrdf::monte_carlo::{BinSpacing, McConfig, simulate};
+use sss_bssrdf::monte_carlo::{BinSpacing, WalkConfig, simulate};
 use sss_bssrdf::quadrature::integrate_radial_range;
 use sss_bssrdf::*;
 
@@ -25,14 +25,14 @@ fn fresh(
     photons: u64,
     seed: u64,
     spacing: BinSpacing,
-) -> monte_carlo::McProfile {
+) -> monte_carlo::WalkProfile {
     let (bins, r_max) = match &spacing {
         BinSpacing::Edges(e) => (e.len() - 1, e[e.len() - 1]),
         BinSpacing::Linear => unreachable!("the tests give edges"),
     };
     simulate(
         medium,
-        &McConfig {
+        &WalkConfig {
             photons,
             seed,
             r_max,

@@ -3,7 +3,7 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use sss_bssrdf::monte_carlo::{BinSpacing, McConfig, simulate};
+use sss_bssrdf::monte_carlo::{BinSpacing, WalkConfig, simulate};
 use sss_bssrdf::presets::PRESETS;
 use sss_bssrdf::quadrature::{integrate, integrate_radial};
 use sss_bssrdf::*;
@@ -355,7 +355,7 @@ fn models_against_monte_carlo() {
     let bins = 40;
     let mc = simulate(
         &m,
-        &McConfig {
+        &WalkConfig {
             photons: 100_000,
             seed: 11,
             r_max: 8.0,

@@ -27,7 +27,7 @@
 //! nothing and R = 1 − H(1)√(1 − ω), the identity the unit tests use.
 
 use sss_bssrdf::Medium;
-use sss_bssrdf::monte_carlo::{BinSpacing, McConfig, simulate};
+use sss_bssrdf::monte_carlo::{BinSpacing, WalkConfig, simulate};
 use sss_bssrdf::quadrature::gauss_legendre;
 
 const PI: f64 = std::f64::consts::PI;
@@ -219,7 +219,7 @@ fn monte_carlo_total_matches_the_deterministic_solver_with_a_refractive_boundary
         let m = Medium::from_extinction_albedo([1.0; 3], [omega; 3], 0.0, eta).unwrap();
         let prof = simulate(
             &m,
-            &McConfig {
+            &WalkConfig {
                 photons,
                 seed: 100 + i as u64,
                 r_max: 10.0,

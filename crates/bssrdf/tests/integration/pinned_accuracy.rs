@@ -16,7 +16,7 @@
 //! collision); photon beam diffusion, normalized diffusion, `mc-table` and the directional
 //! dipole against the full tally (the directional dipole puts a source of strength 1, not α′, at the ray's
 //! first scattering event — Frisvad et al. 2014, Eq. 20 — so it stands for all scattered light;
-//! `McPart::All` in crates/compare/src/profiles/registry.rs).
+//! `WalkPart::All` in crates/compare/src/profiles/registry.rs).
 //!
 //! # Margins
 //! The simulation is seeded ([`SEED`]) and bit-identical for any thread count, so every value
@@ -50,7 +50,7 @@
 //! a few times larger, so their pins are looser. Measured: the better dipole with α′ for α′²
 //! fails 32 values on six presets, the standard dipole with z_v × 1.1 fails 18 on eight.
 
-use sss_bssrdf::monte_carlo::{BinSpacing, McConfig, McProfile, simulate};
+use sss_bssrdf::monte_carlo::{BinSpacing, WalkConfig, WalkProfile, simulate};
 use sss_bssrdf::quadrature::integrate_radial_range;
 use sss_bssrdf::*;
 
@@ -365,10 +365,16 @@ fn r_max(medium: &Medium, ch: usize) -> f64 {
     make_model(SD, medium).radius_for_energy(ch, 0.99)
 }
 
-fn simulate_channel(medium: &Medium, ch: usize, photons: u64, seed: u64, bins: usize) -> McProfile {
+fn simulate_channel(
+    medium: &Medium,
+    ch: usize,
+    photons: u64,
+    seed: u64,
+    bins: usize,
+) -> WalkProfile {
     simulate(
         medium,
-        &McConfig {
+        &WalkConfig {
             photons,
             seed,
             r_max: r_max(medium, ch),
@@ -381,7 +387,7 @@ fn simulate_channel(medium: &Medium, ch: usize, photons: u64, seed: u64, bins: u
 }
 
 /// The model's area average of R_d over each bin of `mc`.
-fn bin_averages(model: &dyn Bssrdf, ch: usize, mc: &McProfile) -> Vec<f64> {
+fn bin_averages(model: &dyn Bssrdf, ch: usize, mc: &WalkProfile) -> Vec<f64> {
     let scale = model.medium().reduced_mean_free_path(ch);
     mc.bin_edges
         .windows(2)
@@ -397,7 +403,7 @@ fn models_everything(kind: ModelKind) -> bool {
 }
 
 /// (relative L2 error of the energy per bin, model total / Monte Carlo total) of `kind`.
-fn compare(medium: &Medium, kind: ModelKind, ch: usize, mc: &McProfile) -> (f64, f64) {
+fn compare(medium: &Medium, kind: ModelKind, ch: usize, mc: &WalkProfile) -> (f64, f64) {
     let model = make_model(kind, medium);
     let (reference, total): (Vec<f64>, f64) = if models_everything(kind) {
         (mc.rd[ch].clone(), mc.total[ch])
@@ -626,7 +632,7 @@ fn monte_carlo_profile_scales_with_the_coefficients() {
     let run = |m: &Medium, r_max: f64, seed: u64| {
         simulate(
             m,
-            &McConfig {
+            &WalkConfig {
                 photons: 65_536,
                 seed,
                 r_max,
@@ -664,7 +670,7 @@ fn monte_carlo_profile_scales_with_the_coefficients() {
     );
     // First radial moment inside r_max by bin centres (the same quadrature for both runs, so
     // it scales exactly like the profile); its standard error treats the bins as independent.
-    let moment = |p: &McProfile| {
+    let moment = |p: &WalkProfile| {
         let (mut m, mut var) = (0.0, 0.0);
         for ((c, area), (v, s)) in p
             .bin_centers()

@@ -54,9 +54,9 @@
 //! directory.
 
 mod equal;
+mod pathtraced;
 mod plan;
 mod plots;
-mod reference;
 mod report;
 mod runs;
 mod scoring;
@@ -67,9 +67,9 @@ mod tests;
 use super::output::{Csv, csv_num, csv_text, md_num, md_table};
 use super::{Context, Error, Experiment, Section};
 use equal::{Reach, error_at_time, extrapolated_time, time_to_reach};
+use pathtraced::{Budget, Reference, path_reference};
 use plan::*;
 use plots::*;
-use reference::{Budget, Reference, path_reference};
 use report::*;
 use runs::*;
 use scoring::*;

@@ -16,7 +16,7 @@ pub struct Evaluation {
     /// Channel 0..3.
     pub channel: usize,
     /// The Monte Carlo part the method is measured against.
-    pub part: McPart,
+    pub part: WalkPart,
     /// The method's area averages over the reference bins (1/mm²).
     pub bin_avg: Vec<f64>,
     /// Relative L2 error of the energy per bin.

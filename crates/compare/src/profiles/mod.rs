@@ -21,7 +21,7 @@ mod report;
 mod tests;
 
 use super::output::{Csv, csv_num, csv_text, md_num, md_pct, md_table};
-use super::reference::{CHANNEL_NAMES, McPart, PresetReference};
+use super::walk_reference::{CHANNEL_NAMES, PresetReference, WalkPart};
 use super::{Context, Error, Experiment, Section};
 use evaluation::*;
 use metrics::{

@@ -49,7 +49,7 @@ pub(super) fn plot_preset(
                 centers
                     .iter()
                     .copied()
-                    .zip(mc.rd_of(McPart::Multiple))
+                    .zip(mc.rd_of(WalkPart::Multiple))
                     .collect(),
             )
             .with_color([110, 110, 110])

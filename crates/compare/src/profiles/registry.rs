@@ -12,7 +12,7 @@ pub trait ProfileMethod: Sync {
     /// Seconds a build takes from scratch, without process-wide caches (best of three).
     fn cold_build_seconds(&self, medium: &Medium) -> f64;
     /// The part of the Monte Carlo transport the method models, and is measured against.
-    fn reference_part(&self) -> McPart;
+    fn reference_part(&self) -> WalkPart;
 }
 
 /// One of the `sss_bssrdf` models.
@@ -34,13 +34,13 @@ impl ProfileMethod for ModelMethod {
     /// the ray's first scattering event, so it stands for all scattered light and is measured
     /// against the full tally too. The standard and better dipoles model multiple scattering
     /// only.
-    fn reference_part(&self) -> McPart {
+    fn reference_part(&self) -> WalkPart {
         match self.0 {
             ModelKind::PhotonBeamDiffusion
             | ModelKind::Burley
             | ModelKind::DirectionalDipole
-            | ModelKind::McTable => McPart::All,
-            ModelKind::StandardDipole | ModelKind::BetterDipole => McPart::Multiple,
+            | ModelKind::McTable => WalkPart::All,
+            ModelKind::StandardDipole | ModelKind::BetterDipole => WalkPart::Multiple,
         }
     }
 

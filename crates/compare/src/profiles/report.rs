@@ -117,7 +117,7 @@ pub(super) fn preset_md(
                     md_num(Some(c.total), 4),
                     md_num(Some(c.total_se), 2)
                 ),
-                md_num(Some(c.total_of(McPart::Multiple)), 4),
+                md_num(Some(c.total_of(WalkPart::Multiple)), 4),
                 md_num(Some(reference.preset.published_rd[ch]), 2),
                 c.capped.to_string(),
                 c.seconds.map_or("cached".into(), |t| format!("{t:.1}")),

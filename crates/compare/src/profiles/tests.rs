@@ -18,7 +18,7 @@ fn eval(preset: &'static str, method: &str, channel: usize, rel_l2: f64) -> Eval
         preset,
         method: method.into(),
         channel,
-        part: McPart::All,
+        part: WalkPart::All,
         bin_avg: vec![],
         rel_l2: Some(rel_l2),
         max_rel: None,
@@ -73,19 +73,19 @@ fn summary_leads_with_medians_and_one_bad_channel_cannot_dominate_it() {
 fn the_directional_dipole_is_measured_against_the_full_tally() {
     assert!(matches!(
         ModelMethod(ModelKind::DirectionalDipole).reference_part(),
-        McPart::All
+        WalkPart::All
     ));
     assert!(matches!(
         ModelMethod(ModelKind::BetterDipole).reference_part(),
-        McPart::Multiple
+        WalkPart::Multiple
     ));
     assert!(matches!(
         ModelMethod(ModelKind::Burley).reference_part(),
-        McPart::All
+        WalkPart::All
     ));
     assert!(matches!(
         ModelMethod(ModelKind::McTable).reference_part(),
-        McPart::All
+        WalkPart::All
     ));
 }
 

@@ -34,7 +34,7 @@ use super::output::write_atomic;
 use super::scenes::{
     self, PlanOutline, SceneInfo, SweepUnit, UnitResult, escape, run_units, unescape,
 };
-use super::{Config, Context, Error, Experiment, Section, kernels, profiles, reference};
+use super::{Config, Context, Error, Experiment, Section, kernels, profiles, walk_reference};
 use balance::*;
 use manifest::*;
 pub use merge::merge;
@@ -108,7 +108,7 @@ impl std::fmt::Display for Shard {
 pub fn prepare(config: &Config, ctx_log: &dyn Fn(&str)) -> Result<(), Error> {
     let presets = super::check(config)?;
     let bar = sss_util::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
-    reference::load_or_compute(config, &presets, ctx_log, &bar)?;
+    walk_reference::load_or_compute(config, &presets, ctx_log, &bar)?;
     bar.finish_and_clear();
     let ctx = Context {
         config,
@@ -167,7 +167,7 @@ pub fn run_shard(config: &Config, shard: Shard, log: &dyn Fn(&str)) -> Result<()
     ));
     if mine.contains(&Work::Profiles) {
         let bar = sss_util::progress::bar(presets.len() as u64 * 3 * config.photons, "photons");
-        let references = reference::load_or_compute(config, &presets, log, &bar)?;
+        let references = walk_reference::load_or_compute(config, &presets, log, &bar)?;
         bar.finish_and_clear();
         let ctx = Context {
             config,

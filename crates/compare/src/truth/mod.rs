@@ -32,12 +32,12 @@ pub(crate) mod deficit;
 mod images;
 mod peers;
 mod plan;
-mod reference;
 mod report;
 mod runs;
 mod scoring;
 #[cfg(test)]
 mod tests;
+mod volpath_reference;
 
 use super::checked::{self, Entry, fnv1a64};
 use super::output::{Csv, csv_num, csv_text, md_num, md_pct, md_table};
@@ -45,7 +45,6 @@ use super::{Context, Error, Experiment, Section};
 use images::{SIGNED_RANGE, write_pictures, write_plot};
 use peers::{Peers, run_peers};
 use plan::{Case, Plan, plan, with_albedo_weights, with_ball_profile, with_drift};
-use reference::{Truth, reference};
 use report::{CaseResult, section, truth_csv};
 use runs::{EXACT_SAMPLES, FAST, FAST_MODEL, PATHTRACE_SPP, TruthRun, run_case};
 use scoring::{Crossover, Score, score, score_without_noise};
@@ -66,6 +65,7 @@ use sss_util::luminance;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use volpath_reference::{Truth, reference};
 
 /// The truth experiment.
 pub struct TruthExperiment;

@@ -70,11 +70,11 @@ fn a_cached_reference_round_trips_and_damage_is_named() {
     t.translucent = vec![1];
     // A 2 × 1 image has no interior pixel.
     t.pixels = Vec::new();
-    let bytes = reference::encode(&t);
-    assert_eq!(reference::decode(&bytes).unwrap(), t);
+    let bytes = volpath_reference::encode(&t);
+    assert_eq!(volpath_reference::decode(&bytes).unwrap(), t);
     let cut = &bytes[..bytes.len() - 1];
     assert!(
-        reference::decode(cut)
+        volpath_reference::decode(cut)
             .unwrap_err()
             .contains("bytes after the header")
     );
@@ -82,7 +82,7 @@ fn a_cached_reference_round_trips_and_damage_is_named() {
     let at = bad.len() - 4;
     bad[at] = 7;
     assert!(
-        reference::decode(&bad)
+        volpath_reference::decode(&bad)
             .unwrap_err()
             .contains("out of range")
     );
@@ -93,11 +93,17 @@ fn a_cached_reference_round_trips_and_damage_is_named() {
 #[test]
 fn the_scored_pixels_are_those_inside_the_silhouette() {
     let block: Vec<usize> = (0..20).filter(|i| i % 5 < 4 && i / 5 < 3).collect();
-    assert_eq!(reference::interior(&block, 5, 4), vec![6, 7]);
+    assert_eq!(volpath_reference::interior(&block, 5, 4), vec![6, 7]);
     let full: Vec<usize> = (0..20).collect();
-    assert_eq!(reference::interior(&full, 5, 4), vec![6, 7, 8, 11, 12, 13]);
+    assert_eq!(
+        volpath_reference::interior(&full, 5, 4),
+        vec![6, 7, 8, 11, 12, 13]
+    );
     let holed: Vec<usize> = full.iter().copied().filter(|&i| i != 12).collect();
-    assert_eq!(reference::interior(&holed, 5, 4), Vec::<usize>::new());
+    assert_eq!(
+        volpath_reference::interior(&holed, 5, 4),
+        Vec::<usize>::new()
+    );
 }
 
 #[test]

@@ -5,10 +5,10 @@ use crate::common::brute_force_sphere;
 use glam::DVec3;
 use sss_manylight::StudentT;
 use sss_render::frame::Frame;
+use sss_render::integrators::vpl::vpls::{DISTANT_FACTOR, scene_vpls};
 use sss_render::integrators::{self, MethodOptions};
 use sss_render::progress::NoProgress;
 use sss_render::scene::{LoadOptions, Scene, builtin};
-use sss_render::vpls::{DISTANT_FACTOR, scene_vpls};
 use sss_render::{RenderSettings, render};
 use sss_scene::Light;
 use std::f64::consts::PI;
@@ -591,10 +591,17 @@ fn bounce_vpls_carry_the_reflected_power() {
                 |(a, c), (p, q)| (a.min(p), c.max(q)),
             );
         let (center, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
-        let v = sss_render::vpls::bounce_vpls(s, &frame.geom, paths, 7, center, radius);
+        let v = sss_render::integrators::vpl::vpls::bounce_vpls(
+            s,
+            &frame.geom,
+            paths,
+            7,
+            center,
+            radius,
+        );
         let total: f64 = v.iter().map(|x| PI * x.intensity[0]).sum();
         // Each path lands with probability p; the sum is (power / N) × hits.
-        let power = sss_render::vpls::light_power(&s.lights[0], radius)[0];
+        let power = sss_render::integrators::vpl::vpls::light_power(&s.lights[0], radius)[0];
         let p = (want / rho / power).min(1.0);
         let se = want * ((1.0 - p) / (p * f64::from(paths))).sqrt();
         assert!(

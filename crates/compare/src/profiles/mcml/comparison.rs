@@ -9,9 +9,9 @@ pub struct Comparison {
     pub case: String,
     /// Model name.
     pub model: String,
-    /// What the model models: [`McPart::Multiple`] for the standard and better dipoles
+    /// What the model models: [`WalkPart::Multiple`] for the standard and better dipoles
     /// (MCML always has every order).
-    pub part: McPart,
+    pub part: WalkPart,
     /// The case's η.
     pub eta: f64,
     /// Anisotropy.
@@ -51,7 +51,7 @@ impl Comparison {
 }
 
 /// `model` (named `name`, modelling `part`) against `case`.
-pub fn compare(case: &Case, name: &str, part: McPart, model: &dyn Bssrdf) -> Comparison {
+pub fn compare(case: &Case, name: &str, part: WalkPart, model: &dyn Bssrdf) -> Comparison {
     let rows = case.rows(model);
     let total_model = model.total_diffuse_reflectance(0);
     Comparison {

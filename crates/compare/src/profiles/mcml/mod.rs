@@ -34,7 +34,7 @@ mod tests;
 use super::metrics::median;
 use super::{ModelMethod, ProfileMethod};
 use crate::output::{Csv, csv_num, csv_text, md_num, md_pct, md_table};
-use crate::reference::McPart;
+use crate::walk_reference::WalkPart;
 use crate::{Error, Section};
 use bins::*;
 pub use cases::*;

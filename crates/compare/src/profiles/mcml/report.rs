@@ -65,10 +65,10 @@ pub(super) fn max_of(values: impl Iterator<Item = Option<f64>>) -> Option<f64> {
     values.flatten().filter(|v| v.is_finite()).reduce(f64::max)
 }
 
-pub(super) fn dagger(part: McPart) -> &'static str {
+pub(super) fn dagger(part: WalkPart) -> &'static str {
     match part {
-        McPart::Multiple => " †",
-        McPart::All => "",
+        WalkPart::Multiple => " †",
+        WalkPart::All => "",
     }
 }
 
@@ -79,7 +79,7 @@ pub(super) fn report(
     skipped: &[String],
     dir: &Path,
 ) -> (String, String) {
-    let mut models: Vec<(&str, McPart)> = Vec::new();
+    let mut models: Vec<(&str, WalkPart)> = Vec::new();
     for c in rows {
         if !models.iter().any(|(m, _)| *m == c.model) {
             models.push((&c.model, c.part));

@@ -52,7 +52,7 @@ fn one(dir: &Path) -> (Vec<Case>, Vec<String>) {
 
 fn against_dipole(case: &Case) -> Comparison {
     let model = make_model(ModelKind::StandardDipole, &case.medium);
-    compare(case, "standard-dipole", McPart::Multiple, model.as_ref())
+    compare(case, "standard-dipole", WalkPart::Multiple, model.as_ref())
 }
 
 #[test]

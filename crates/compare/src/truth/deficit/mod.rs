@@ -38,7 +38,7 @@ mod setups;
 mod tests;
 
 use super::plan::with_albedo_weights;
-use super::reference::interior;
+use super::volpath_reference::interior;
 use super::{Context, Error, Experiment, Section};
 use measure::{Mean, measure};
 use report::{DeficitRow, deficit_csv, section, write_plots};

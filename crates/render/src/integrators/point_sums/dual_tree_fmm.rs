@@ -235,20 +235,6 @@ impl DualTreeFmm {
     }
 }
 
-/// R_d and its first two radial derivatives per channel at scene-unit distance `r`, in scene
-/// units (R_d(r/u)/u², R_d′(r/u)/u³, R_d″(r/u)/u⁴ with u the scene units per mm).
-pub fn rd_derivatives_scene(sh: &TranslucentShading, r: f64) -> [[f64; 3]; 3] {
-    let u = sh.units_per_mm;
-    let m = sh.bssrdf();
-    let x = r / u;
-    let s0 = 1.0 / (u * u);
-    let (s1, s2) = (s0 / u, s0 / (u * u));
-    std::array::from_fn(|c| {
-        let (v, d1, d2) = m.rd_derivatives(c, x);
-        [v * s0, d1 * s1, d2 * s2]
-    })
-}
-
 /// A local expansion about a pixel node's centre, per channel: value, gradient and the
 /// symmetric Hessian (xx, xy, xz, yy, yz, zz).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -534,7 +520,7 @@ impl Fmm<'_> {
         let rd = if near {
             self.sh.rd_sample_derivatives_scene(r, area)?
         } else {
-            rd_derivatives_scene(self.sh, r)
+            self.sh.rd_derivatives_scene(r)
         };
         for d in &rd {
             let reach = if near && d[0] > 0.0 && d[1] != 0.0 {

@@ -2,7 +2,7 @@
 //! Student-t error control (Nabata & Iwasaki, IEEE TVCG 2021), the estimator of
 //! [`sss_manylight`] wired to the frame.
 //!
-//! Per visible translucent object: the VPLs of the scene's lights ([`crate::vpls`], direct light
+//! Per visible translucent object: the VPLs of the scene's lights ([`super::vpls`], direct light
 //! only) in one [`LightTree`](sss_manylight::LightTree), a triangle BVH over the object's mesh ([`TriangleClusterTree`](sss_manylight::TriangleClusterTree)), the
 //! radial profile `R_d` in scene units (the material's model, as
 //! [`TranslucentShading::rd_scene`](crate::shading::TranslucentShading::rd_scene) evaluates it)
@@ -45,7 +45,7 @@
 //!
 //! **Indirect light** is off by default (renders stay comparable with `exact` and
 //! `pathtrace`); `--bounce-vpls N` adds the VPLs of one bounce off opaque diffuse surfaces
-//! ([`crate::vpls::bounce_vpls`]).
+//! ([`super::vpls::bounce_vpls`]).
 //!
 //! **Not supported** (clear errors): the directional dipole (not radial) and pre-scatter
 //! textures (the estimator's irradiance has no texture factor).
@@ -56,6 +56,7 @@ pub use super::{
     parse_selection,
 };
 
+use super::vpls::vpl_count;
 use super::{eps_sweep, estimator_options, pixel_list, pixel_result};
 use crate::Error;
 use crate::frame::Frame;
@@ -67,7 +68,6 @@ use crate::integrators::{
     Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
 };
 use crate::progress::Progress;
-use crate::vpls::vpl_count;
 use sss_manylight::irradiance_cluster::IcNode;
 use sss_manylight::{LightNode, Selection, Settings, Summary, Triangle, Vpl};
 use sss_scene::Scene;

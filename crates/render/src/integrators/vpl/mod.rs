@@ -13,6 +13,7 @@
 pub mod gather_points;
 pub mod manylight;
 pub mod sparse_manylight;
+pub mod vpls;
 
 use crate::Error;
 use crate::frame::Frame;
@@ -20,7 +21,6 @@ use crate::integrators::check_radial;
 use crate::integrators::options::{alpha_option, eps_option};
 use crate::integrators::{MethodOptions, OptionSpec};
 use crate::progress::Progress;
-use crate::vpls::{bounce_vpls, scene_vpls};
 use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
@@ -30,6 +30,7 @@ use sss_manylight::{
     ShadingTree, StudentT, Summary, Transmittance, TriangleClusterTree, pixel_seed,
 };
 use sss_scene::Scene;
+use vpls::{bounce_vpls, scene_vpls};
 
 /// The relative rise of R_d(r) accepted when the profile is checked (against the running
 /// minimum, see `RadialProfile::with_tolerance`); the bounds are inflated by it. The tabulated
@@ -140,7 +141,7 @@ pub(crate) fn object_data(
         let model: std::sync::Arc<dyn sss_bssrdf::Bssrdf> =
             crate::shading::material_model(t).into();
         let u = sh.units_per_mm;
-        let inv_u2 = 1.0 / (u * u);
+        let [inv_u2, _, _] = crate::shading::scene_unit_factors(u);
         let diag = frame
             .geom
             .bounds(o)
@@ -276,7 +277,7 @@ pub struct ManyLight {
     pub max_triplets: usize,
     /// Cap on the triangle splits per pixel and object.
     pub max_splits: usize,
-    /// Light paths for one-bounce VPLs ([`crate::vpls::bounce_vpls`]; 0: direct light only).
+    /// Light paths for one-bounce VPLs ([`vpls::bounce_vpls`]; 0: direct light only).
     pub bounce_paths: u32,
     /// Seed of the VPL sampling (`None`: the render's seed). Fixing it keeps one VPL set, and
     /// so one integral, across renders of different seeds, as the paper's comparisons do.

@@ -55,11 +55,11 @@ use super::{
 use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::options::{IRRADIANCE_POINTS, MAX_PAIRS, UNIFORM_POINTS, VPLS};
+use crate::integrators::vpl::vpls::vpl_count;
 use crate::integrators::{Layer, MethodOptions, OptionSpec, Shaded, Stat, check_radial};
 use crate::probe::{Sampler, Scratch, default_probe_energy, probe_radii};
 use crate::progress::Progress;
 use crate::rng::{Stream, rng};
-use crate::vpls::vpl_count;
 use rand::RngExt;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;

@@ -14,7 +14,7 @@
 //! not simulated and not counted (at normal incidence the transmitted beam keeps its
 //! direction, so every photon starts at the origin heading straight down with weight 1). The
 //! bin values are therefore directly comparable with the models' [`crate::Bssrdf::rd`] (1/mm²),
-//! and [`McProfile::total`] with [`crate::Bssrdf::total_diffuse_reflectance`]. Each bin holds the
+//! and [`WalkProfile::total`] with [`crate::Bssrdf::total_diffuse_reflectance`]. Each bin holds the
 //! *area average* of R_d over its annulus, tally / (N · π(r₁² − r₀²)).
 //!
 //! # Physics and estimators
@@ -36,8 +36,8 @@
 //!   and continues with the remaining optical depth. η = 1 gives F = 0 (everything escapes),
 //!   η > 1 gives total internal reflection (F = 1) beyond the critical angle, η < 1 has none.
 //! - Cap: a photon about to undergo collision [`MAX_SCATTERING_EVENTS`] + 1 is stopped; it is
-//!   counted in [`McProfile::capped`] and the weight it still carried in
-//!   [`McProfile::capped_weight`] (it is *not* tallied). This only matters for albedo 1 (or
+//!   counted in [`WalkProfile::capped`] and the weight it still carried in
+//!   [`WalkProfile::capped_weight`] (it is *not* tallied). This only matters for albedo 1 (or
 //!   nearly), where walks have a heavy tail (the fraction of photons surviving n collisions
 //!   decays like 1/√n); for albedo 1, `total + capped_weight` is 1 up to the roulette noise.
 //!
@@ -102,13 +102,13 @@ pub fn memory_bytes(bins: usize, threads: usize) -> u64 {
 
 /// What to simulate. Plain data; checked by [`simulate`].
 #[derive(Clone, Debug, PartialEq)]
-pub struct McConfig {
+pub struct WalkConfig {
     /// Photons per simulated channel (≥ 1).
     pub photons: u64,
     /// Master seed; channels and chunks derive independent streams from it.
     pub seed: u64,
     /// Outer radius of the radial bins (mm, finite, > 0). Weight escaping beyond it still
-    /// counts in [`McProfile::total`].
+    /// counts in [`WalkProfile::total`].
     pub r_max: f64,
     /// Number of radial bins over [0, r_max] (1..=[`MAX_BINS`]).
     pub bins: usize,
@@ -119,7 +119,7 @@ pub struct McConfig {
     pub spacing: BinSpacing,
 }
 
-/// The layout of the radial bins of a [`McConfig`].
+/// The layout of the radial bins of a [`WalkConfig`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub enum BinSpacing {
     /// `bins` bins of equal width over [0, r_max].
@@ -150,7 +150,7 @@ impl BinSpacing {
     }
 }
 
-impl McConfig {
+impl WalkConfig {
     /// Checks the configuration; [`simulate`] calls it first.
     pub fn validate(&self) -> Result<(), BssrdfError> {
         let bad = |msg: String| Err(BssrdfError::InvalidArgument(msg));
@@ -194,7 +194,7 @@ impl McConfig {
 
 /// The tallied radial profile of a simulation. All values are finite.
 #[derive(Clone, Debug, PartialEq)]
-pub struct McProfile {
+pub struct WalkProfile {
     /// Bin edges in mm: `bins + 1` values from 0 to `r_max` (linear, or as given by
     /// [`BinSpacing::Edges`]).
     pub bin_edges: Vec<f64>,
@@ -222,7 +222,7 @@ pub struct McProfile {
     pub total_single: Rgb,
 }
 
-impl McProfile {
+impl WalkProfile {
     /// Centre of each bin (mm).
     pub fn bin_centers(&self) -> Vec<f64> {
         self.bin_edges
@@ -247,8 +247,8 @@ fn annulus_area(r0: f64, r1: f64) -> f64 {
 /// Runs the photon random walk for every selected channel of `medium`.
 ///
 /// Errors with [`BssrdfError::InvalidArgument`] on a bad configuration (see
-/// [`McConfig::validate`]).
-pub fn simulate(medium: &Medium, cfg: &McConfig) -> Result<McProfile, BssrdfError> {
+/// [`WalkConfig::validate`]).
+pub fn simulate(medium: &Medium, cfg: &WalkConfig) -> Result<WalkProfile, BssrdfError> {
     simulate_with_progress(medium, cfg, &|_| {})
 }
 
@@ -257,9 +257,9 @@ pub fn simulate(medium: &Medium, cfg: &McConfig) -> Result<McProfile, BssrdfErro
 /// chunk. Calls may come from worker threads but are serialised and their values increase.
 pub fn simulate_with_progress(
     medium: &Medium,
-    cfg: &McConfig,
+    cfg: &WalkConfig,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<McProfile, BssrdfError> {
+) -> Result<WalkProfile, BssrdfError> {
     simulate_impl(medium, cfg, MAX_SCATTERING_EVENTS, progress)
 }
 
@@ -679,10 +679,10 @@ fn standard_error(s: f64, s2: f64, n: f64) -> f64 {
 
 pub(crate) fn simulate_impl(
     medium: &Medium,
-    cfg: &McConfig,
+    cfg: &WalkConfig,
     max_events: u64,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<McProfile, BssrdfError> {
+) -> Result<WalkProfile, BssrdfError> {
     simulate_in(medium, cfg, max_events, None, false, progress)
 }
 
@@ -701,8 +701,8 @@ pub(crate) fn simulate_impl(
 pub fn simulate_sphere(
     medium: &Medium,
     radius: f64,
-    cfg: &McConfig,
-) -> Result<McProfile, BssrdfError> {
+    cfg: &WalkConfig,
+) -> Result<WalkProfile, BssrdfError> {
     if !(radius.is_finite() && radius > 0.0) {
         return Err(BssrdfError::InvalidArgument(format!(
             "Monte Carlo: the sphere's radius must be finite and > 0, got {radius} mm"
@@ -724,20 +724,20 @@ pub fn simulate_sphere(
 /// thousands of collisions sooner, at more noise per photon.
 pub(crate) fn simulate_analog(
     medium: &Medium,
-    cfg: &McConfig,
+    cfg: &WalkConfig,
     sphere: Option<f64>,
-) -> Result<McProfile, BssrdfError> {
+) -> Result<WalkProfile, BssrdfError> {
     simulate_in(medium, cfg, MAX_SCATTERING_EVENTS, sphere, true, &|_| {})
 }
 
 fn simulate_in(
     medium: &Medium,
-    cfg: &McConfig,
+    cfg: &WalkConfig,
     max_events: u64,
     sphere: Option<f64>,
     analog: bool,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<McProfile, BssrdfError> {
+) -> Result<WalkProfile, BssrdfError> {
     cfg.validate()?;
     let bins = cfg.bins;
     let dr = cfg.r_max / bins as f64;
@@ -831,7 +831,7 @@ fn simulate_in(
         capped_weight[ch] = t.capped_weight / n;
         capped += t.capped;
     }
-    Ok(McProfile {
+    Ok(WalkProfile {
         bin_edges,
         rd,
         se,
@@ -870,8 +870,8 @@ mod tests {
     /// caps ~1 % of the photons while bounding the cost per photon to ~500 collisions.
     const TEST_CAP: u64 = 20_000;
 
-    fn cfg(photons: u64, seed: u64, r_max: f64, bins: usize) -> McConfig {
-        McConfig {
+    fn cfg(photons: u64, seed: u64, r_max: f64, bins: usize) -> WalkConfig {
+        WalkConfig {
             photons,
             seed,
             r_max,
@@ -1016,7 +1016,7 @@ mod tests {
                     * std::f64::consts::PI
                     * sigma_s
             };
-            let c = McConfig {
+            let c = WalkConfig {
                 channels: [false, true, false],
                 ..cfg(200_000, 5, 1.0, 10)
             };
@@ -1177,11 +1177,11 @@ mod tests {
     #[test]
     fn results_are_bit_identical_across_thread_counts() {
         let m = Medium::preset("skin1").unwrap();
-        let c = McConfig {
+        let c = WalkConfig {
             channels: [true, true, true],
             ..cfg(3 * CHUNK_PHOTONS + 123, 42, 20.0, 16)
         };
-        let run = |threads: usize, cfg: &McConfig| {
+        let run = |threads: usize, cfg: &WalkConfig| {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
@@ -1190,7 +1190,7 @@ mod tests {
         };
         let one = run(1, &c);
         let two = run(2, &c);
-        let bits = |p: &McProfile| -> Vec<u64> {
+        let bits = |p: &WalkProfile| -> Vec<u64> {
             (0..3)
                 .flat_map(|ch| p.rd[ch].iter().chain(&p.se[ch]).map(|v| v.to_bits()))
                 .chain(p.total.iter().map(|v| v.to_bits()))
@@ -1200,7 +1200,7 @@ mod tests {
         assert_eq!(one, two);
         let other = run(
             2,
-            &McConfig {
+            &WalkConfig {
                 seed: 43,
                 ..c.clone()
             },
@@ -1210,7 +1210,7 @@ mod tests {
         let grey = medium(0.9, 0.0, 1.3);
         let g = simulate(
             &grey,
-            &McConfig {
+            &WalkConfig {
                 channels: [true; 3],
                 ..c
             },
@@ -1222,7 +1222,7 @@ mod tests {
     #[test]
     fn progress_reports_every_photon() {
         let m = medium(0.5, 0.0, 1.0);
-        let c = McConfig {
+        let c = WalkConfig {
             channels: [true, false, true],
             ..cfg(2 * CHUNK_PHOTONS + 7, 1, 1.0, 3)
         };
@@ -1240,35 +1240,35 @@ mod tests {
         let good = cfg(10, 0, 1.0, 4);
         assert!(simulate(&m, &good).is_ok());
         let bad = [
-            McConfig {
+            WalkConfig {
                 photons: 0,
                 ..good.clone()
             },
-            McConfig {
+            WalkConfig {
                 bins: 0,
                 ..good.clone()
             },
-            McConfig {
+            WalkConfig {
                 bins: MAX_BINS + 1,
                 ..good.clone()
             },
-            McConfig {
+            WalkConfig {
                 r_max: 0.0,
                 ..good.clone()
             },
-            McConfig {
+            WalkConfig {
                 r_max: -1.0,
                 ..good.clone()
             },
-            McConfig {
+            WalkConfig {
                 r_max: f64::NAN,
                 ..good.clone()
             },
-            McConfig {
+            WalkConfig {
                 r_max: f64::INFINITY,
                 ..good.clone()
             },
-            McConfig {
+            WalkConfig {
                 channels: [false; 3],
                 ..good.clone()
             },
@@ -1280,7 +1280,7 @@ mod tests {
             );
         }
         // A single photon is valid; its standard errors are reported as 0.
-        let one = simulate(&m, &McConfig { photons: 1, ..good }).unwrap();
+        let one = simulate(&m, &WalkConfig { photons: 1, ..good }).unwrap();
         assert!(one.se[0].iter().all(|&s| s == 0.0) && one.total_se[0] == 0.0);
     }
 
@@ -1292,7 +1292,7 @@ mod tests {
         // With K = 60 the sample standard deviation is good to ~9 %.
         let m = medium(0.9, 0.3, 1.3);
         let k = 60;
-        let runs: Vec<McProfile> = (0..k)
+        let runs: Vec<WalkProfile> = (0..k)
             .map(|seed| simulate(&m, &cfg(4000, 1000 + seed, 2.0, 4)).unwrap())
             .collect();
         let spread = |v: &[f64]| {
@@ -1300,7 +1300,7 @@ mod tests {
             (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
         };
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-        let pick = |f: &dyn Fn(&McProfile) -> f64| runs.iter().map(f).collect::<Vec<f64>>();
+        let pick = |f: &dyn Fn(&WalkProfile) -> f64| runs.iter().map(f).collect::<Vec<f64>>();
         let cases = [
             ("bin 0", pick(&|p| p.rd[0][0]), pick(&|p| p.se[0][0])),
             ("bin 2", pick(&|p| p.rd[0][2]), pick(&|p| p.se[0][2])),

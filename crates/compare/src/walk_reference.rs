@@ -14,7 +14,7 @@
 
 use super::checked::{self, Entry};
 use super::{Config, Error};
-use sss_bssrdf::monte_carlo::{self, BinSpacing, McConfig};
+use sss_bssrdf::monte_carlo::{self, BinSpacing, WalkConfig};
 use sss_bssrdf::presets::Preset;
 use sss_bssrdf::{Medium, ModelKind, make_model};
 use std::fmt::Write as _;
@@ -57,7 +57,7 @@ pub struct ChannelReference {
 
 /// Which part of the Monte Carlo transport a method is measured against.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum McPart {
+pub enum WalkPart {
     /// Everything that escaped (single and multiple scattering).
     All,
     /// Multiple scattering only: the total minus the photons that escaped after exactly one
@@ -65,22 +65,22 @@ pub enum McPart {
     Multiple,
 }
 
-impl McPart {
+impl WalkPart {
     /// Name in the CSV and report (`all`, `multiple`).
     pub fn name(self) -> &'static str {
         match self {
-            McPart::All => "all",
-            McPart::Multiple => "multiple",
+            WalkPart::All => "all",
+            WalkPart::Multiple => "multiple",
         }
     }
 }
 
 impl ChannelReference {
     /// The binned R_d of `part`.
-    pub fn rd_of(&self, part: McPart) -> Vec<f64> {
+    pub fn rd_of(&self, part: WalkPart) -> Vec<f64> {
         match part {
-            McPart::All => self.rd.clone(),
-            McPart::Multiple => self
+            WalkPart::All => self.rd.clone(),
+            WalkPart::Multiple => self
                 .rd
                 .iter()
                 .zip(&self.rd_single)
@@ -90,10 +90,10 @@ impl ChannelReference {
     }
 
     /// The total diffuse reflectance of `part`.
-    pub fn total_of(&self, part: McPart) -> f64 {
+    pub fn total_of(&self, part: WalkPart) -> f64 {
         match part {
-            McPart::All => self.total,
-            McPart::Multiple => (self.total - self.total_single).max(0.0),
+            WalkPart::All => self.total,
+            WalkPart::Multiple => (self.total - self.total_single).max(0.0),
         }
     }
 
@@ -135,14 +135,14 @@ pub fn r_max_for(medium: &Medium, ch: usize) -> f64 {
     }
 }
 
-fn cache_path(dir: &Path, preset: &str, ch: usize, cfg: &McConfig) -> PathBuf {
+fn cache_path(dir: &Path, preset: &str, ch: usize, cfg: &WalkConfig) -> PathBuf {
     dir.join(format!(
         "mc-v{CACHE_VERSION}-{preset}-{}-p{}-s{}-b{}-r{:e}.csv",
         CHANNEL_NAMES[ch], cfg.photons, cfg.seed, cfg.bins, cfg.r_max
     ))
 }
 
-fn key_line(preset: &str, ch: usize, cfg: &McConfig) -> String {
+fn key_line(preset: &str, ch: usize, cfg: &WalkConfig) -> String {
     format!(
         "# sss monte-carlo reference v{CACHE_VERSION}: preset={preset} channel={} photons={} seed={} bins={} r_max={:e}",
         CHANNEL_NAMES[ch], cfg.photons, cfg.seed, cfg.bins, cfg.r_max
@@ -175,7 +175,7 @@ fn serialize(key: &str, r: &ChannelReference) -> String {
 
 /// Parses a cache file; `None` when it does not match `key` or is malformed (then the
 /// reference is recomputed).
-fn deserialize(text: &str, key: &str, cfg: &McConfig) -> Option<ChannelReference> {
+fn deserialize(text: &str, key: &str, cfg: &WalkConfig) -> Option<ChannelReference> {
     let mut lines = text.lines();
     if lines.next()? != key {
         return None;
@@ -234,7 +234,11 @@ fn deserialize(text: &str, key: &str, cfg: &McConfig) -> Option<ChannelReference
 
 /// A cached channel reference: `Ok(None)` when there is none, `Err(reason)` when the file
 /// must not be trusted (it fails its checksum, or does not parse as the reference of `key`).
-fn load_cached(path: &Path, key: &str, cfg: &McConfig) -> Result<Option<ChannelReference>, String> {
+fn load_cached(
+    path: &Path,
+    key: &str,
+    cfg: &WalkConfig,
+) -> Result<Option<ChannelReference>, String> {
     match checked::check(path) {
         Entry::Missing => Ok(None),
         Entry::Corrupt(reason) => Err(reason),
@@ -263,7 +267,7 @@ pub fn load_or_compute(
         let medium = Medium::preset(preset.name).map_err(|e| Error(e.to_string()))?;
         let mut channels = Vec::with_capacity(3);
         for (ch, channel_name) in CHANNEL_NAMES.iter().enumerate() {
-            let cfg = McConfig {
+            let cfg = WalkConfig {
                 photons: config.photons,
                 seed: config.seed,
                 r_max: r_max_for(&medium, ch),
@@ -338,7 +342,7 @@ mod tests {
 
     #[test]
     fn cache_round_trip_is_exact() {
-        let cfg = McConfig {
+        let cfg = WalkConfig {
             photons: 10,
             seed: 3,
             r_max: 0.1 + 0.2,
@@ -367,17 +371,17 @@ mod tests {
         assert_eq!(deserialize(&cut, &key, &cfg), None);
         let parsed = deserialize(&text, &key, &cfg).unwrap();
         assert_eq!(
-            parsed.rd_of(McPart::Multiple),
+            parsed.rd_of(WalkPart::Multiple),
             vec![1.0 / 3.0 - 0.125, 1e-300]
         );
-        assert!((parsed.total_of(McPart::Multiple) - 0.5).abs() < 1e-15);
-        assert_eq!(parsed.total_of(McPart::All), 0.7);
+        assert!((parsed.total_of(WalkPart::Multiple) - 0.5).abs() < 1e-15);
+        assert_eq!(parsed.total_of(WalkPart::All), 0.7);
     }
 
     #[test]
     fn cached_file_is_checked_before_it_is_trusted() {
         use crate::checked::{sum_path, tests as t};
-        let cfg = McConfig {
+        let cfg = WalkConfig {
             photons: 10,
             seed: 3,
             r_max: 2.0,
