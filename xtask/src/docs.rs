@@ -1,6 +1,8 @@
 //! `cargo xtask docs`: writes `docs/cli.md`, the command-line reference generated from the clap
-//! definitions of `sss` and of `cargo xtask` and from the method registry; `--check` compares
-//! instead of writing (and a unit test does the same, so the test suite fails on a stale file).
+//! definitions of `sss` and of `cargo xtask` and from the method registry, and
+//! `docs/test-index.md`, where each source file's tests are ([`crate::test_index`]); `--check`
+//! compares instead of writing (and unit tests do the same, so the test suite fails on a stale
+//! file).
 
 use std::path::{Path, PathBuf};
 
@@ -52,9 +54,20 @@ fn experiments() -> String {
     out
 }
 
-/// Writes `text` to the reference's path, or with `check` fails when the file differs.
+/// Writes the reference (`text`) and the test index, or with `check` fails when either file
+/// differs from what is generated now.
 pub fn run(root: &Path, text: &str, check: bool) -> Result<(), String> {
-    let p = path(root);
+    write_or_check(&path(root), text, check)?;
+    write_or_check(
+        &crate::test_index::path(root),
+        &crate::test_index::markdown(root),
+        check,
+    )
+}
+
+/// Writes `text` to `p`, or with `check` fails when the file differs.
+pub fn write_or_check(p: &Path, text: &str, check: bool) -> Result<(), String> {
+    let p = p.to_path_buf();
     if check {
         let current = std::fs::read_to_string(&p)
             .map_err(|e| format!("{}: cannot read: {e}", p.display()))?;

@@ -7,7 +7,8 @@
 //!   (see [`check_results`]).
 //! - `cargo xtask fuzz`: seeded fuzzing of the scene, OBJ and EXR readers and the `sss`
 //!   command line on stable Rust (see [`fuzz`]).
-//! - `cargo xtask docs`: regenerates `docs/cli.md`, the command-line reference (see [`docs`]).
+//! - `cargo xtask docs`: regenerates `docs/cli.md`, the command-line reference, and
+//!   `docs/test-index.md`, where each source file's tests are (see [`docs`]).
 //! - `cargo xtask tables`: regenerates the `mc-table` model's Monte Carlo table
 //!   (`crates/bssrdf/data/mc_table.bin`, see [`tables`]).
 
@@ -17,6 +18,7 @@ mod check_results;
 mod docs;
 mod fuzz;
 mod tables;
+mod test_index;
 
 use clap::{Parser, Subcommand};
 use sss_compare as compare;
@@ -44,9 +46,9 @@ enum Task {
         dir: PathBuf,
     },
     /// Regenerate docs/cli.md, the command-line reference, from the clap definitions and the
-    /// method registry.
+    /// method registry, and docs/test-index.md, where each source file's tests are.
     Docs {
-        /// Compare with the committed file instead of writing it (fails if they differ).
+        /// Compare with the committed files instead of writing them (fails if they differ).
         #[arg(long)]
         check: bool,
     },
