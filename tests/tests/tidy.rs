@@ -250,8 +250,8 @@ fn the_path_scan_sees_groups_and_chains_but_not_comments() {
 }
 
 /// The top-level entries a repository path in the docs starts with.
-const TOP: [&str; 8] = [
-    "crates/", "docs/", "scenes/", "tests/", "xtask/", "fuzz/", ".ci/", ".cargo/",
+const TOP: [&str; 9] = [
+    "crates/", "docs/", "scenes/", "tests/", "xtask/", "fuzz/", ".ci/", ".cargo/", "results/",
 ];
 
 /// The repository paths `text` names: text in backticks or a Markdown link's target that
@@ -504,4 +504,122 @@ fn the_manifest_scan_reads_both_dependency_tables() {
                     sss-peers.workspace = true\nsss-util.workspace = true\n\n\
                     [features]\nsss-render = []\n";
     assert_eq!(workspace_dependencies(manifest), ["util", "gpu", "peers"]);
+}
+
+/// Every file under `dir`, recursively, whatever its extension.
+fn every_file(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            every_file(&p, out);
+        } else {
+            out.push(p);
+        }
+    }
+}
+
+/// The first date in `line` of the form `YYYY-MM-DD` (four ASCII digits, a dash, two, a dash,
+/// two; the numbers are not checked as a calendar's), if any, less the dates that name a record
+/// in `results/` (`results/YYYY-MM-DD-topic.md`), which the docs cite for their figures.
+fn first_date(line: &str) -> Option<&str> {
+    const SHAPE: &[u8; 10] = b"dddd-dd-dd";
+    let b = line.as_bytes();
+    (0..b.len().saturating_sub(SHAPE.len() - 1))
+        .find(|&i| {
+            let shaped = SHAPE.iter().zip(&b[i..]).all(|(&s, &c)| {
+                if s == b'd' {
+                    c.is_ascii_digit()
+                } else {
+                    c == s
+                }
+            });
+            shaped && !b[..i].ends_with(b"results/")
+        })
+        // The match is ASCII, so both ends are character boundaries.
+        .map(|i| &line[i..i + SHAPE.len()])
+}
+
+/// The docs carry no dated lab notes: README.md, ARCHITECTURE.md, every file under `docs/` and
+/// every crate's `src/lib.rs` say what is measured, how, and what it means, without a date of
+/// the form `YYYY-MM-DD`. The figures of a dated run (date, host, command, commit) live in
+/// `results/`, which is exempt: one file per record, `results/YYYY-MM-DD-topic.md`, which the
+/// docs may name.
+#[test]
+fn docs_carry_no_dates() {
+    let root = root();
+    let mut files = vec![root.join("README.md"), root.join("ARCHITECTURE.md")];
+    every_file(&root.join("docs"), &mut files);
+    let mut crate_roots = Vec::new();
+    for dir in ["crates", "tests", "xtask"] {
+        rust_files(&root.join(dir), &mut crate_roots);
+    }
+    crate_roots.retain(|p| p.ends_with("src/lib.rs"));
+    assert!(
+        crate_roots.len() >= 10,
+        "only {} crate roots found under {}",
+        crate_roots.len(),
+        root.display()
+    );
+    files.extend(crate_roots);
+    let mut dated = Vec::new();
+    for f in &files {
+        let bytes = std::fs::read(f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        let text = String::from_utf8_lossy(&bytes);
+        for (n, line) in text.lines().enumerate() {
+            if let Some(date) = first_date(line) {
+                dated.push(format!(
+                    "{}:{}: {date}",
+                    f.strip_prefix(&root).unwrap_or(f).display(),
+                    n + 1
+                ));
+            }
+        }
+    }
+    assert!(
+        dated.is_empty(),
+        "{} dated lines in the docs (move the dated figures to a `results/YYYY-MM-DD-topic.md` \
+         and link it):\n{}",
+        dated.len(),
+        dated.join("\n")
+    );
+}
+
+/// The date scan by hand: a date anywhere in a line, alone or in a range; not a record's name in
+/// `results/`, nor anything else of digits and dashes or dots.
+#[test]
+fn the_date_scan_finds_dates_and_only_dates() {
+    assert_eq!(first_date("2026-12-05"), Some("2026-12-05"));
+    assert_eq!(
+        first_date("Measured on 2026-12-05 (21 minutes)"),
+        Some("2026-12-05")
+    );
+    assert_eq!(
+        first_date("the earlier run of 2026-12-04/05, then 2027-01-02"),
+        Some("2026-12-04")
+    );
+    assert_eq!(first_date("–×·2026-12-05·"), Some("2026-12-05"));
+    assert_eq!(
+        first_date("figures: `results/2026-12-05-trees.md`, run on 2026-12-06"),
+        Some("2026-12-06")
+    );
+    for not_a_date in [
+        "",
+        "1-2-3",
+        "version 0.30",
+        "in 2026",
+        "2026-12",
+        "2026-1-05",
+        "26-12-05",
+        "2026/12/05",
+        "2026-12-0",
+        "12 026-12-05",
+        "commit `9d7f230`, 1 309 CPU-seconds, 0.3–0.75 mm",
+        "the figures of the last run: `results/2026-12-05-compare-trees.md`",
+        "[a record](results/2026-12-05-compare-trees.md)",
+    ] {
+        assert_eq!(first_date(not_a_date), None, "{not_a_date:?}");
+    }
 }

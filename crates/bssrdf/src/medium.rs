@@ -276,4 +276,31 @@ mod tests {
         assert_eq!(e.sigma_a(), [1.5; 3]);
         assert_eq!(e.sigma_s(), [0.5; 3]);
     }
+
+    /// A spec builds its medium (η defaulting to the presets' 1.3) and names it for a title.
+    #[test]
+    fn specs_build_and_name_their_media() {
+        let preset = MediumSpec::Preset("skin1".into());
+        let m = preset.medium(None).unwrap();
+        assert_eq!(m, Medium::preset("skin1").unwrap());
+        assert_eq!(preset.label(&m), "skin1, eta 1.3");
+        let m2 = preset.medium(Some(1.4)).unwrap();
+        assert_eq!(m2.eta(), 1.4);
+        let coeffs = MediumSpec::Coefficients {
+            sigma_a: [0.5, 0.25, 1.0],
+            sigma_s: [2.0, 2.0, 2.0],
+            g: 0.5,
+        };
+        let m3 = coeffs.medium(Some(1.2)).unwrap();
+        assert_eq!(
+            m3,
+            Medium::new([0.5, 0.25, 1.0], [2.0, 2.0, 2.0], 0.5, 1.2).unwrap()
+        );
+        assert_eq!(
+            coeffs.label(&m3),
+            "sigma_a [0.5, 0.25, 1.0], sigma_s [2.0, 2.0, 2.0], g 0.5, eta 1.2"
+        );
+        assert!(MediumSpec::Preset("nope".into()).medium(None).is_err());
+        assert!(preset.medium(Some(-1.0)).is_err());
+    }
 }

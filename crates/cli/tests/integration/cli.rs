@@ -795,6 +795,15 @@ fn render_bad_input_fails_with_one_line() {
         ),
         (vec!["render", scene, "--method", "magic"], "magic"),
         (vec!["diff", "nope-a.exr", "nope-b.exr"], "nope-a.exr"),
+        // The old --eps, split into two quantities, names the one the method takes.
+        (
+            vec!["render", scene, "--method", "dual-tree", "--eps", "0.1"],
+            "method dual-tree takes --solid-angle",
+        ),
+        (
+            vec!["render", scene, "--method", "eelc", "--eps", "0.1"],
+            "method eelc takes --rel-error",
+        ),
     ];
     for (args, needle) in cases {
         let o = sss(&args);

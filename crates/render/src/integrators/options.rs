@@ -430,7 +430,11 @@ mod tests {
         for m in crate::integrators::METHODS {
             let (taken, others) = given.partition(m);
             assert!(taken.names().any(|n| n == "eps"), "{}", m.name);
-            assert!(!others.iter().any(|n| n == "eps"), "{}", m.name);
+            // Another method's option is set aside (for a warning), the method's own kept.
+            let takes_taps = m.options.iter().any(|o| o.name == "taps");
+            let expected: &[&str] = if takes_taps { &[] } else { &["taps"] };
+            assert_eq!(others, expected, "{}", m.name);
+            assert_eq!(taken.names().any(|n| n == "taps"), takes_taps, "{}", m.name);
             let msg = crate::integrators::build(m.name, &taken)
                 .err()
                 .unwrap_or_else(|| panic!("{} took --eps", m.name))
@@ -453,6 +457,29 @@ mod tests {
             for n in takes {
                 crate::integrators::build(m.name, &MethodOptions::new().with(n, 0.1)).unwrap();
             }
+        }
+    }
+
+    /// The thresholds are read under the name asked for, and NaN, infinite or negative values
+    /// are refused naming that flag.
+    #[test]
+    fn thresholds_are_read_and_checked_by_name() {
+        let specs = [SOLID_ANGLE, REL_ERROR];
+        let none = MethodOptions::new();
+        assert_eq!(eps_option(&none, &specs, "solid-angle").unwrap(), 0.05);
+        assert_eq!(eps_option(&none, &specs, "rel-error").unwrap(), 0.02);
+        let given = MethodOptions::new()
+            .with("solid-angle", 0.3)
+            .with("rel-error", 0);
+        assert_eq!(eps_option(&given, &specs, "solid-angle").unwrap(), 0.3);
+        assert_eq!(eps_option(&given, &specs, "rel-error").unwrap(), 0.0);
+        for bad in ["-0.1", "NaN", "inf"] {
+            let o = MethodOptions::new().with("rel-error", bad);
+            let msg = eps_option(&o, &specs, "rel-error").unwrap_err().to_string();
+            assert!(
+                msg.starts_with("--rel-error must be finite and >= 0"),
+                "{msg}"
+            );
         }
     }
 }

@@ -271,6 +271,11 @@ fn scenes_by_name_or_file_with_the_callers_hint() {
 
     let dir = std::env::temp_dir().join(format!("sss-load-named-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    // A path that exists but cannot be read as a file (a directory): an I/O error that names
+    // the file, with no list of built-in scenes (the user named a file, not a scene).
+    let e = sss_scene::load_named(dir.to_str().unwrap(), &[], "HINT").unwrap_err();
+    assert_eq!(e.kind, SceneErrorKind::Io, "{e}");
+    assert!(!e.message.contains("built-in scene"), "{e}");
     let scene = dir.join("s.toml");
     std::fs::write(
         &scene,
