@@ -143,15 +143,16 @@ class Kernel:
 
 def kernel(
     model: Model,
-    method: str = "preintegrated",
+    method: str | None = None,
     *,
-    taps: int = 7,
+    taps: int | None = None,
     uniform: bool = False,
-    k: float = 2.0,
+    k: float | None = None,
     artist_preset: str | None = None,
     normalize: bool = False,
 ) -> Kernel:
-    """The separable kernel of `model` (`method` one of `KERNELS` but "exact2d")."""
+    """The separable kernel of `model` (`method` one of `KERNELS` but "exact2d"); None takes
+    `sss kernel`'s default (preintegrated, 7 taps, k = 2)."""
 
 def filter(
     irradiance: F32,

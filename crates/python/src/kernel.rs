@@ -158,28 +158,35 @@ impl Kernel {
     }
 }
 
-/// kernel(model, method="preintegrated", *, taps=7, uniform=False, k=2.0,
-/// artist_preset=None, normalize=False) -> Kernel
+/// kernel(model, method=None, *, taps=None, uniform=False, k=None, artist_preset=None,
+/// normalize=False) -> Kernel
 ///
 /// The separable kernel `sss kernel` exports for `model` (a `Model`): `method` one of
 /// preintegrated, svd1, svd3, svd6, artist, guided, gaussians1, gaussians6; `taps` per 1D
 /// pass; `uniform` places taps uniformly instead of by importance; `k` is the guided
 /// exponent; `artist_preset` uses a Table 2 parameter set with method "artist"; `normalize`
-/// scales the weights to sum to 1 instead of the total diffuse reflectance.
+/// scales the weights to sum to 1 instead of the total diffuse reflectance. None takes `sss
+/// kernel`'s default (preintegrated, 7 taps, k = 2), from the library's one statement of them.
 #[pyfunction]
-#[pyo3(signature = (model, method="preintegrated", *, taps=7, uniform=false, k=2.0, artist_preset=None, normalize=false))]
+#[pyo3(signature = (model, method=None, *, taps=None, uniform=false, k=None, artist_preset=None, normalize=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn kernel(
     py: Python<'_>,
     model: &Model,
-    method: &str,
-    taps: usize,
+    method: Option<&str>,
+    taps: Option<usize>,
     uniform: bool,
-    k: f64,
+    k: Option<f64>,
     artist_preset: Option<String>,
     normalize: bool,
 ) -> PyResult<Kernel> {
-    let method: KernelMethod = method.parse().map_err(value_error)?;
+    let defaults = KernelRequest::new(model.spec().clone());
+    let method: KernelMethod = match method {
+        Some(m) => m.parse().map_err(value_error)?,
+        None => defaults.method,
+    };
+    let taps = taps.unwrap_or(defaults.taps);
+    let k = k.unwrap_or(defaults.k);
     let mut kernel = Kernel {
         kind: model.kind(),
         spec: model.spec().clone(),
