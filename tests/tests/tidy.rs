@@ -10,19 +10,24 @@ fn root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Every file under `dir` whose extension is `ext`, recursively.
-fn files_with_extension(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
+/// Every file under `dir` that `keep` accepts, recursively.
+fn files_where(dir: &Path, keep: &dyn Fn(&Path) -> bool, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
     for e in entries.flatten() {
         let p = e.path();
         if p.is_dir() {
-            files_with_extension(&p, ext, out);
-        } else if p.extension().is_some_and(|x| x == ext) {
+            files_where(&p, keep, out);
+        } else if keep(&p) {
             out.push(p);
         }
     }
+}
+
+/// Every file under `dir` whose extension is `ext`, recursively.
+fn files_with_extension(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
+    files_where(dir, &|p| p.extension().is_some_and(|x| x == ext), out);
 }
 
 /// Every `.rs` file under `dir`, recursively.
@@ -506,21 +511,6 @@ fn the_manifest_scan_reads_both_dependency_tables() {
     assert_eq!(workspace_dependencies(manifest), ["util", "gpu", "peers"]);
 }
 
-/// Every file under `dir`, recursively, whatever its extension.
-fn every_file(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            every_file(&p, out);
-        } else {
-            out.push(p);
-        }
-    }
-}
-
 /// The first date in `line` of the form `YYYY-MM-DD` (four ASCII digits, a dash, two, a dash,
 /// two; the numbers are not checked as a calendar's), if any, less the dates that name a record
 /// in `results/` (`results/YYYY-MM-DD-topic.md`), which the docs cite for their figures.
@@ -551,7 +541,7 @@ fn first_date(line: &str) -> Option<&str> {
 fn docs_carry_no_dates() {
     let root = root();
     let mut files = vec![root.join("README.md"), root.join("ARCHITECTURE.md")];
-    every_file(&root.join("docs"), &mut files);
+    files_where(&root.join("docs"), &|_| true, &mut files);
     let mut crate_roots = Vec::new();
     for dir in ["crates", "tests", "xtask"] {
         rust_files(&root.join(dir), &mut crate_roots);

@@ -49,10 +49,8 @@ pub fn frame_bytes(width: u32, height: u32, spp: u32) -> u64 {
         .saturating_add(pixels.saturating_mul(BYTES_PER_PIXEL))
 }
 
-/// `n` bytes for a person: `1.5 GiB` ([`sss_util::human_bytes`]).
-pub fn human(n: u64) -> String {
-    sss_util::human_bytes(n)
-}
+/// `n` bytes for a person: `1.5 GiB`.
+pub use sss_util::human_bytes as human;
 
 /// Parses a byte count: a number with an optional suffix K, M, G or T (powers of 1024, `B`
 /// and `iB` allowed: `512M`, `8GiB`, `1.5G`, `1000000`).
