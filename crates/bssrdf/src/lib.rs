@@ -38,7 +38,10 @@
 //! - [`sphere_profile`] reshapes a radial model to a ball of radius R: the same walk in a ball
 //!   ([`monte_carlo::simulate_sphere`], tallied by chord distance, which a sphere's hat-box
 //!   area πr² turns into a radial profile on [0, 2R]) minus the walk in the half-space, added
-//!   to the model's profile ([`SphereProfile`]; the scene format's `sphere_radius`).
+//!   to the model's profile ([`SphereProfile`]; the scene format's `sphere_radius`); a
+//!   [`BallFamily`] holds such walks at radii 2^(k/2) mm and reads a pair of points' own ball
+//!   between them, for a renderer that gives each point its own radius (`sphere_radius =
+//!   "local"`).
 //! - [`entry_drift`] gives where obliquely entering light leaves: the first azimuthal harmonic
 //!   k(r, θ_i) of the same walk's exit density about the light's direction along the surface
 //!   ([`EntryDrift`]), for a renderer to multiply S by 1 + k(r, θ_i) cos φ_i + k(r, θ_o)
@@ -106,6 +109,7 @@ pub use inversion::from_reflectance;
 pub use mc_table::McTableModel;
 pub use medium::{Medium, MediumSpec};
 pub use photon_beam_diffusion::PhotonBeamDiffusion;
+pub use sphere_profile::family::BallFamily;
 pub use sphere_profile::{SphereDelta, SphereProfile};
 pub use standard_dipole::StandardDipole;
 

@@ -89,6 +89,7 @@ pub mod irradiance;
 pub mod kernel_choice;
 pub mod kernel_export;
 pub mod lights;
+pub mod local_radius;
 pub mod metrics;
 pub mod pipeline;
 pub mod probe;

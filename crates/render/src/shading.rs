@@ -157,6 +157,12 @@ pub struct TranslucentShading {
     pub weights: BoundaryWeights,
     /// The walk's drift of obliquely entering light (`drift = true`), or `None`.
     pub drift: Option<Arc<EntryDrift>>,
+    /// Whether each point has its own ball (`sphere_radius = "local"`,
+    /// [`crate::local_radius`]); the model is then the half-space's, and a drifting material's
+    /// drift is its balls' ([`sss_bssrdf::BallFamily::with_drift`]), not [`Self::drift`].
+    pub local_radius: bool,
+    /// `drift = true` with `sphere_radius = "local"`: each pair's ball drifts.
+    pub local_drift: bool,
     /// The disk-average quadrature of [`rd_sample_scene`](Self::rd_sample_scene).
     disk: DiskRule,
 }
@@ -203,7 +209,8 @@ impl TranslucentShading {
         let disk = DiskRule::new(model.bssrdf(), &t.medium, t.units_per_mm);
         // The loader refuses `drift` on the directional dipole; the walk refuses only radii
         // the loader refuses too.
-        let drift = if t.drift && t.model != ModelKind::DirectionalDipole {
+        let local = t.local_radius && t.model != ModelKind::DirectionalDipole;
+        let drift = if t.drift && !local && t.model != ModelKind::DirectionalDipole {
             EntryDrift::cached(&t.medium, t.sphere_radius.map(|r| r / t.units_per_mm)).ok()
         } else {
             None
@@ -218,6 +225,8 @@ impl TranslucentShading {
             texture: t.texture.clone(),
             weights: BoundaryWeights::of(t),
             drift,
+            local_radius: local,
+            local_drift: local && t.drift,
             disk,
         }
     }
@@ -286,6 +295,31 @@ impl TranslucentShading {
             let rd = self.rd_sample_scene((position - x).length(), area);
             for c in 0..3 {
                 acc[c] += rd[c] * e[c] * area;
+            }
+        }
+    }
+
+    /// [`add_point_sum`](Self::add_point_sum) with each pair's own ball
+    /// ([`crate::local_radius`]): the sample's R_d ([`rd_sample_scene`](Self::rd_sample_scene))
+    /// reshaped by `family` to the ball of radius √(R_x R_i) (mm), `radius_x` the shading
+    /// point's radius and each point's last field its own (NaN: the half-space's profile).
+    pub fn add_point_sum_local(
+        &self,
+        acc: &mut Rgb,
+        x: DVec3,
+        radius_x: f64,
+        family: &sss_bssrdf::BallFamily,
+        points: impl IntoIterator<Item = (DVec3, f64, Rgb, f64)>,
+    ) {
+        let u = self.units_per_mm;
+        let [s, _, _] = scene_unit_factors(u);
+        for (position, area, e, radius_i) in points {
+            let r = (position - x).length();
+            let rd = self.rd_sample_scene(r, area);
+            let radius = (radius_x * radius_i).sqrt();
+            let v = family.reshape_rgb(r / u, radius, rd.map(|v| v / s));
+            for c in 0..3 {
+                acc[c] += v[c] * s * e[c] * area;
             }
         }
     }
@@ -535,11 +569,23 @@ impl TranslucentShading {
     pub fn entering_towards(
         &self,
         packets: &[Incident],
+        xi: (DVec3, DVec3),
+        xo: (DVec3, DVec3, DVec3),
+    ) -> Rgb {
+        self.entering_towards_with(self.drift.as_deref(), packets, xi, xo)
+    }
+
+    /// [`entering_towards`](Self::entering_towards) with the drift `drift` (a pair's own
+    /// ball's, [`sss_bssrdf::BallFamily::drift`]) instead of the material's.
+    pub fn entering_towards_with(
+        &self,
+        drift: Option<&EntryDrift>,
+        packets: &[Incident],
         (xi, ni): (DVec3, DVec3),
         (xo, no, wo): (DVec3, DVec3, DVec3),
     ) -> Rgb {
         // The drift read at this pair's chord, and the exit's k and azimuth, once per pair.
-        let exit = self.drift.as_ref().map(|drift| {
+        let exit = drift.map(|drift| {
             let at = drift.at((xo - xi).length() / self.units_per_mm);
             (
                 at,
@@ -564,10 +610,26 @@ impl TranslucentShading {
         e
     }
 
-    /// Ok when the material does not drift; otherwise an error naming the material and
-    /// `method`, which sums one irradiance per point (only `exact` and `pathtrace` keep each
-    /// packet's direction).
+    /// Ok unless the material gives each point its own ball (`sphere_radius = "local"`),
+    /// which only `exact` reads; otherwise an error naming the material and `method`.
+    pub fn one_profile(&self, method: &str) -> Result<(), crate::Error> {
+        if self.local_radius {
+            Err(crate::Error::Unsupported(format!(
+                "material `{}`: method {method} takes one profile per material; \
+                 `sphere_radius = \"local\"` gives each pair of points its own ball (use exact)",
+                self.name
+            )))
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Ok when the material neither drifts nor gives each point its own ball
+    /// (`sphere_radius = "local"`); otherwise an error naming the material and `method`, which
+    /// sums one irradiance per point with one profile (only `exact` and `pathtrace` keep each
+    /// packet's direction; only `exact` each point's radius).
     pub fn no_drift(&self, method: &str) -> Result<(), crate::Error> {
+        self.one_profile(method)?;
         if self.drift.is_none() {
             Ok(())
         } else {
@@ -799,6 +861,7 @@ mod tests {
                 texture: None,
                 angular: Default::default(),
                 sphere_radius: None,
+                local_radius: false,
                 drift: false,
             },
         )
@@ -839,6 +902,7 @@ mod tests {
             texture: None,
             angular: Default::default(),
             sphere_radius: None,
+            local_radius: false,
             drift: true,
         };
         let drifting = TranslucentShading::new("test", &t);

@@ -76,13 +76,13 @@ pub(super) struct MaterialDef {
     pub drift: Option<bool>,
 }
 
-/// `sphere_radius = 12.5` (scene units) or `sphere_radius = "auto"`.
+/// `sphere_radius = 12.5` (scene units), `sphere_radius = "auto"` or `sphere_radius = "local"`.
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
 pub(super) enum RadiusDef {
     /// A length in scene units.
     Value(f64),
-    /// A keyword (only `auto` is accepted).
+    /// A keyword (`auto` or `local`).
     Keyword(String),
 }
 

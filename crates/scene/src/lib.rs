@@ -193,6 +193,10 @@ pub struct Translucent {
     /// The file gives a length or `"auto"`: 3 V/A of the material's objects (their volume
     /// over their area, the radius of a ball for a ball).
     pub sphere_radius: Option<f64>,
+    /// `sphere_radius = "local"`: each point's own ball radius, 3/4 of its mean
+    /// cosine-weighted chord into the object, the pair's ball the geometric mean of its two
+    /// points' (`sss_bssrdf::BallFamily`); `sphere_radius` is then `None`. False by default.
+    pub local_radius: bool,
     /// Whether the light entering at an angle leaves ahead of its entry point, as the random
     /// walk says (`sss_bssrdf::EntryDrift`: S times 1 + k(r, θ_i) cos φ), instead of evenly
     /// around it (false, the default).

@@ -329,11 +329,22 @@ impl EntryDrift {
     /// The factors of one medium and ball radius (`None`: the half-space), walked once per
     /// process and shared.
     pub fn cached(medium: &Medium, radius: Option<f64>) -> Result<Arc<EntryDrift>, BssrdfError> {
-        type Cache = Mutex<HashMap<([u64; 8], Option<u64>), Arc<EntryDrift>>>;
+        Self::cached_with(medium, radius, PHOTONS)
+    }
+
+    /// [`EntryDrift::cached`] with `photons` per node and channel (kept apart per count).
+    pub fn cached_with(
+        medium: &Medium,
+        radius: Option<f64>,
+        photons: u64,
+    ) -> Result<Arc<EntryDrift>, BssrdfError> {
+        type Cache = Mutex<HashMap<([u64; 8], Option<u64>, u64), Arc<EntryDrift>>>;
         static CACHE: OnceLock<Cache> = OnceLock::new();
-        memoized(&CACHE, (medium.bits(), radius.map(f64::to_bits)), || {
-            EntryDrift::new(medium, radius)
-        })
+        memoized(
+            &CACHE,
+            (medium.bits(), radius.map(f64::to_bits), photons),
+            || EntryDrift::with_photons(medium, radius, photons),
+        )
     }
 
     /// The ball's radius (mm), `None` for the half-space.

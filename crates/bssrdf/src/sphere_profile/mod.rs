@@ -154,10 +154,19 @@ impl SphereDelta {
     /// The difference of one medium and radius, computed once per process and shared (the
     /// walks take from a fraction of a second to seconds per medium).
     pub fn cached(medium: &Medium, radius: f64) -> Result<Arc<SphereDelta>, BssrdfError> {
-        type Cache = Mutex<HashMap<([u64; 8], u64), Arc<SphereDelta>>>;
+        Self::cached_with(medium, radius, PHOTONS)
+    }
+
+    /// [`SphereDelta::cached`] with `photons` per channel and shape (kept apart per count).
+    pub fn cached_with(
+        medium: &Medium,
+        radius: f64,
+        photons: u64,
+    ) -> Result<Arc<SphereDelta>, BssrdfError> {
+        type Cache = Mutex<HashMap<([u64; 8], u64, u64), Arc<SphereDelta>>>;
         static CACHE: OnceLock<Cache> = OnceLock::new();
-        memoized(&CACHE, (medium.bits(), radius.to_bits()), || {
-            SphereDelta::new(medium, radius)
+        memoized(&CACHE, (medium.bits(), radius.to_bits(), photons), || {
+            SphereDelta::with_photons(medium, radius, photons)
         })
     }
 
@@ -284,6 +293,8 @@ impl Bssrdf for SphereProfile {
         self.tables[ch].radius_for_energy(fraction)
     }
 }
+
+pub mod family;
 
 #[cfg(test)]
 mod tests;

@@ -44,7 +44,9 @@ use super::output::{Csv, csv_num, csv_text, md_num, md_pct, md_table};
 use super::{Context, Error, Experiment, Section};
 use images::{SIGNED_RANGE, write_pictures, write_plot};
 use peers::{Peers, run_peers};
-use plan::{Case, Plan, plan, with_albedo_weights, with_ball_profile, with_drift};
+use plan::{
+    Case, Plan, plan, with_albedo_weights, with_ball_profile, with_drift, with_local_balls,
+};
 use report::{CaseResult, section, truth_csv};
 use runs::{EXACT_SAMPLES, FAST, FAST_MODEL, PATHTRACE_SPP, TruthRun, run_case};
 use scoring::{Crossover, Score, score, score_without_noise};

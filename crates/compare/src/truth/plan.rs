@@ -147,6 +147,17 @@ pub(crate) fn with_ball_profile(scene: &mut Scene) {
     }
 }
 
+/// Gives every translucent material of `scene` each point's own ball instead of one radius
+/// (`sphere_radius = "local"`: the chords into the object at each point).
+pub(crate) fn with_local_balls(scene: &mut Scene) {
+    for m in &mut scene.materials {
+        if let MaterialKind::Translucent(t) = &mut m.kind {
+            t.sphere_radius = None;
+            t.local_radius = true;
+        }
+    }
+}
+
 /// Gives every translucent material of `scene` the walk's drift of obliquely entering light
 /// (`drift = true`).
 pub(crate) fn with_drift(scene: &mut Scene) {

@@ -111,22 +111,31 @@ pub(crate) fn section(
                     .iter()
                     .find(|r| r.method == method && r.model == model)
             };
-            let (Some(exact), Some(pt)) = (find("exact"), find("pathtrace")) else {
+            let Some(exact) = find("exact") else {
                 continue;
             };
-            let floor = pt.floor.unwrap_or(pt.score.rel_rmse);
+            // A model `pathtrace` refuses (each point's own ball): its means from `exact`, no
+            // floor.
+            let pt = find("pathtrace");
+            let floor = pt.map(|pt| pt.floor.unwrap_or(pt.score.rel_rmse));
             rows.push(vec![
                 c.case.clone(),
                 model.to_string(),
-                ratios(pt),
-                md_pct(Some(floor)),
+                match pt {
+                    Some(pt) => ratios(pt),
+                    None => format!("{} (exact)", ratios(exact)),
+                },
+                md_pct(floor),
                 if exact.warnings > 0 {
                     format!("{} ⚠", md_pct(Some(exact.score.rel_rmse)))
                 } else {
                     md_pct(Some(exact.score.rel_rmse))
                 },
                 md_num(Some(exact.seconds), 3),
-                md_num(c.crossover.and_then(|x| x.seconds_for(floor)), 3),
+                md_num(
+                    floor.and_then(|f| c.crossover.and_then(|x| x.seconds_for(f))),
+                    3,
+                ),
             ]);
         }
     }

@@ -137,6 +137,11 @@ impl Integrator for PathTrace {
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
+        for &o in &frame.visible {
+            if let Some(sh) = frame.shading_of(o) {
+                sh.one_profile(METHOD.name)?;
+            }
+        }
         let scene = frame.scene;
         let t = std::time::Instant::now();
         // `missed`: the largest energy fraction never sampled, over the materials the image

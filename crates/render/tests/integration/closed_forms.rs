@@ -193,6 +193,7 @@ fn slab(units_per_mm: f64) -> ([f64; 3], [f64; 3]) {
             texture: None,
             angular: Default::default(),
             sphere_radius: None,
+            local_radius: false,
             drift: false,
         }),
     };

@@ -3,10 +3,9 @@
 //! followed through the dielectric and the medium); and through the methods that take the
 //! model by its interface (`exact` and `manylight` against `pathtrace` with the same model).
 
-use sss_render::integrators::{self, MethodOptions};
-use sss_render::progress::NoProgress;
+use super::common::covered_mean;
+use sss_render::integrators::MethodOptions;
 use sss_render::scene::{Scene, load_str};
-use sss_render::{RenderSettings, render};
 
 /// A skin1 sphere of radius 5 mm (4–8 of its reduced mean free paths) under a uniform
 /// environment, seen from 40 mm, 24 × 24 pixels; `mc-table` with the given extra keys.
@@ -37,29 +36,7 @@ fn sphere_scaled(extra: &str, n: u32, u: f64) -> Scene {
 /// Image mean per channel over the pixels the sphere covers, and the mean's standard error
 /// where the method reports one.
 fn mean(scene: &Scene, method: &str, options: MethodOptions, seed: u64) -> ([f64; 3], [f64; 3]) {
-    let m = integrators::build(method, &options).unwrap();
-    let settings = RenderSettings {
-        seed,
-        ..Default::default()
-    };
-    let out = render(scene, m.as_ref(), &settings, &NoProgress).unwrap();
-    let se = out.std_error.clone().unwrap_or_default();
-    let inside: Vec<usize> = (0..out.subsurface.len())
-        .filter(|&i| out.alpha[i] > 0.999)
-        .collect();
-    let n = inside.len() as f64;
-    assert!(n > 20.0, "{n} pixels on the sphere");
-    let mut m = [0.0; 3];
-    let mut v = [0.0; 3];
-    for &i in &inside {
-        for c in 0..3 {
-            m[c] += out.subsurface[i][c] / n;
-            if let Some(s) = se.get(i) {
-                v[c] += s[c] * s[c] / (n * n);
-            }
-        }
-    }
-    (m, v.map(f64::sqrt))
+    covered_mean(scene, method, options, seed, 20)
 }
 
 /// On a 5 mm skin1 sphere under uniform light real transport is brighter than the half-space's

@@ -22,6 +22,7 @@ fn white(sigma_s: [f64; 3]) -> Material {
             texture: None,
             angular: Default::default(),
             sphere_radius: None,
+            local_radius: false,
             drift: false,
         }),
     }

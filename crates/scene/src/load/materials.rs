@@ -164,13 +164,14 @@ impl Ctx<'_> {
                         ));
                     }
                     // Resolved from the material's objects once they are loaded (`assemble`).
-                    Some(RadiusDef::Keyword(k)) if k == "auto" => None,
+                    // `local` leaves the radius to each point (`local_radius`).
+                    Some(RadiusDef::Keyword(k)) if k == "auto" || k == "local" => None,
                     Some(RadiusDef::Keyword(k)) => {
                         return Err(self.err(
                             &key("sphere_radius"),
                             format!(
-                                "unknown sphere radius `{k}`; expected a length in scene units \
-                                 or \"auto\""
+                                "unknown sphere radius `{k}`; expected a length in scene units, \
+                                 \"auto\" or \"local\""
                             ),
                         ));
                     }
@@ -196,6 +197,10 @@ impl Ctx<'_> {
                          `drift` out)",
                     ));
                 }
+                let local_radius = matches!(
+                    &m.sphere_radius,
+                    Some(RadiusDef::Keyword(k)) if k == "local"
+                );
                 Ok(MaterialKind::Translucent(Translucent {
                     model,
                     medium,
@@ -203,6 +208,7 @@ impl Ctx<'_> {
                     texture,
                     angular,
                     sphere_radius,
+                    local_radius,
                     drift,
                 }))
             }

@@ -543,7 +543,39 @@ fn sphere_radius() {
         &with("eta = 1.4", "eta = 1.4\nsphere_radius = \"big\""),
         Some("sphere_radius"),
         Some("materials.jelly.sphere_radius"),
-        &["unknown sphere radius", "big", "auto"],
+        &["unknown sphere radius", "big", "auto", "local"],
+    );
+    // `"local"`: no one radius, each point's own; with or without drift; only that material.
+    let local = |s: &sss_scene::Scene, k: usize| match &s.materials[k].kind {
+        MaterialKind::Translucent(t) => (t.sphere_radius, t.local_radius),
+        _ => panic!("translucent"),
+    };
+    assert_eq!(
+        local(&load_str(GOOD, "good.toml", None, &no_dirs()).unwrap(), 1),
+        (None, false)
+    );
+    for extra in ["", "\ndrift = true"] {
+        let text = with(
+            "eta = 1.4",
+            &format!("eta = 1.4\nsphere_radius = \"local\"{extra}"),
+        );
+        let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+        assert_eq!(local(&s, 1), (None, true), "{extra}");
+        assert_eq!(local(&s, 0), (None, false));
+    }
+    for v in ["\"auto\"", "2.5"] {
+        let text = with("eta = 1.4", &format!("eta = 1.4\nsphere_radius = {v}"));
+        let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+        assert!(!local(&s, 1).1, "{v}");
+    }
+    assert_err(
+        &with(
+            "model = \"directional-dipole\"",
+            "model = \"directional-dipole\"\nsphere_radius = \"local\"",
+        ),
+        Some("sphere_radius = \"local\""),
+        Some("materials.skin.sphere_radius"),
+        &["directional dipole", "radial"],
     );
     assert_err(
         &with(

@@ -20,8 +20,11 @@ use crate::gbuffer::GSample;
 use crate::integrators::Converges;
 use crate::integrators::options::SAMPLE_OPTIONS;
 use crate::integrators::options::sample_settings;
-use crate::integrators::{Integrator, Method, MethodOptions, Shaded, Stat, Sweep, add_weighted};
+use crate::integrators::{
+    Integrator, Layer, Method, MethodOptions, Shaded, Stat, Sweep, add_weighted,
+};
 use crate::irradiance::{IrradianceSettings, ObjectSamples};
+use crate::local_radius::{FrameBalls, LocalBalls, frame_balls};
 use crate::progress::Progress;
 use crate::shading::TranslucentShading;
 use rayon::prelude::*;
@@ -91,15 +94,17 @@ impl Integrator for Exact {
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
         let samples = frame.irradiance_samples(&self.irradiance);
         let by_object = frame.samples_by_object(&samples);
+        let balls = frame_balls(frame, &by_object)?;
         let values: Vec<Rgb> = frame.timed("shading", || {
             frame
                 .gbuffer
                 .samples
                 .par_iter()
-                .map(|g| {
+                .enumerate()
+                .map(|(k, g)| {
                     progress.advance(1);
                     match (frame.shading_of(g.object), by_object[g.object as usize]) {
-                        (Some(sh), Some(s)) => shade(g, sh, s),
+                        (Some(sh), Some(s)) => shade_with(g, sh, s, ball_of(&balls, k, g)),
                         _ => [0.0; 3],
                     }
                 })
@@ -112,12 +117,25 @@ impl Integrator for Exact {
             .filter(|g| frame.shading_of(g.object).is_some())
             .map(|g| by_object[g.object as usize].map_or(0, |s| s.samples.len()))
             .sum();
+        let mut stats = vec![Stat {
+            name: "sample_pairs",
+            value: evaluations as f64,
+        }];
+        let mut layers = Vec::new();
+        if balls.any() {
+            stats.push(Stat {
+                name: "ball_radii",
+                value: balls.nodes() as f64,
+            });
+            layers.push(Layer {
+                name: "local_radius",
+                pixels: balls.pixel_radii(frame),
+            });
+        }
         Ok(Shaded {
             values,
-            stats: vec![Stat {
-                name: "sample_pairs",
-                value: evaluations as f64,
-            }],
+            stats,
+            layers,
             ..Shaded::default()
         })
     }
@@ -125,6 +143,24 @@ impl Integrator for Exact {
 
 /// The subsurface radiance leaving `g` towards the camera.
 pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples) -> Rgb {
+    shade_with(g, shading, samples, None)
+}
+
+/// The balls of G-buffer sample `k` (`g`): its object's and its own radius, when its material
+/// gives each point its own ball.
+fn ball_of<'b>(balls: &'b FrameBalls, k: usize, g: &GSample) -> Option<(&'b LocalBalls, f64)> {
+    let own = balls.objects.get(g.object as usize)?.as_ref()?;
+    Some((own, balls.points.get(k).copied().unwrap_or(f64::NAN)))
+}
+
+/// [`shade`], with each pair's own ball where `ball` gives the object's balls and the shading
+/// point's radius (mm) ([`crate::local_radius`]).
+pub fn shade_with(
+    g: &GSample,
+    shading: &TranslucentShading,
+    samples: &ObjectSamples,
+    ball: Option<(&LocalBalls, f64)>,
+) -> Rgb {
     let mut sum = [0.0; 3];
     if shading.directional() {
         // Full S of the directional dipole, positions in mm.
@@ -145,6 +181,36 @@ pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples)
             }
         }
         return sum;
+    }
+    if let Some((balls, radius)) = ball {
+        // Each pair's ball, and a drifting material's drift in that ball.
+        let family = &balls.family;
+        shading.add_point_sum_local(
+            &mut sum,
+            g.p,
+            radius,
+            family,
+            samples
+                .samples
+                .iter()
+                .zip(&balls.samples)
+                .enumerate()
+                .map(|(i, (s, &r))| {
+                    let e = match family.drift((radius * r).sqrt()) {
+                        Some(d) => shading.entering_towards_with(
+                            Some(d),
+                            samples.incident_of(i),
+                            (s.position, s.normal),
+                            (g.p, g.n, g.wo),
+                        ),
+                        None => s.irradiance,
+                    };
+                    (s.position, s.area, e, r)
+                }),
+        );
+        let mut out = [0.0; 3];
+        add_weighted(&mut out, sum, shading.exit_weights(g.n, g.wo));
+        return out;
     }
     // A drifting material's irradiance depends on the shading point: each sample's packets,
     // each moved by the drift towards g ([`TranslucentShading::entering_towards`]).
@@ -197,21 +263,26 @@ pub fn shade_subset(
     }
     let samples = frame.irradiance_samples(irradiance);
     let by_object = frame.samples_by_object(&samples);
+    let balls = frame_balls(frame, &by_object)?;
     let gb = &frame.gbuffer;
     Ok(frame.timed("shading", || {
         pixels
             .par_iter()
             .map(|&i| {
+                let first = gb.offsets[i] as usize;
                 let values: Vec<Option<Rgb>> = gb
                     .pixel(i)
                     .iter()
-                    .map(
-                        |g| match (frame.shading_of(g.object), by_object[g.object as usize]) {
-                            (Some(sh), Some(s)) => Some(shade(g, sh, s)),
+                    .enumerate()
+                    .map(|(j, g)| {
+                        match (frame.shading_of(g.object), by_object[g.object as usize]) {
+                            (Some(sh), Some(s)) => {
+                                Some(shade_with(g, sh, s, ball_of(&balls, first + j, g)))
+                            }
                             (Some(_), None) => Some([0.0; 3]),
                             _ => None,
-                        },
-                    )
+                        }
+                    })
                     .collect();
                 assembled_subsurface(&values, gb.samples_per_pixel)
             })

@@ -136,6 +136,7 @@ pub fn translucent(model: ModelKind, preset: &str, units_per_mm: f64) -> Materia
             texture: None,
             angular: Default::default(),
             sphere_radius: None,
+            local_radius: false,
             drift: false,
         }),
     }
@@ -281,4 +282,38 @@ pub fn brute_force_sphere(scene: &Scene, frame: &Frame<'_>) -> Vec<[f64; 3]> {
         }
     }
     out
+}
+
+/// Renders `scene` with `method` and returns the mean per channel over the pixels an object
+/// covers fully (alpha 1), and the mean's standard error where the method reports one;
+/// asserts more than `min_pixels` such pixels.
+pub fn covered_mean(
+    scene: &Scene,
+    method: &str,
+    options: MethodOptions,
+    seed: u64,
+    min_pixels: usize,
+) -> ([f64; 3], [f64; 3]) {
+    let m = sss_render::integrators::build(method, &options).unwrap();
+    let settings = sss_render::RenderSettings {
+        seed,
+        ..Default::default()
+    };
+    let out = sss_render::render(scene, m.as_ref(), &settings, &NoProgress).unwrap();
+    let se = out.std_error.clone().unwrap_or_default();
+    let inside: Vec<usize> = (0..out.subsurface.len())
+        .filter(|&i| out.alpha[i] > 0.999)
+        .collect();
+    assert!(inside.len() > min_pixels, "{} pixels covered", inside.len());
+    let n = inside.len() as f64;
+    let (mut m, mut v) = ([0.0; 3], [0.0; 3]);
+    for &i in &inside {
+        for c in 0..3 {
+            m[c] += out.subsurface[i][c] / n;
+            if let Some(s) = se.get(i) {
+                v[c] += s[c] * s[c] / (n * n);
+            }
+        }
+    }
+    (m, v.map(f64::sqrt))
 }
