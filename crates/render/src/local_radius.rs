@@ -250,6 +250,26 @@ mod tests {
         assert!(r < 3.0);
     }
 
+    /// A radius needs at least half the rays to meet the object: from 3 radii off a unit ball,
+    /// facing it, a ninth of the cosine-weighted rays do (sin² 19.5°); on the ball with the
+    /// normal tilted 60° off the true one, more than half do (the half-space
+    /// cos 60° √(1 − ρ²) + sin 60° x > 0 of the projected unit disk).
+    #[test]
+    fn half_the_rays_decide() {
+        let g = geometry(
+            "[[objects]]\nmaterial = \"skin\"\nshape = \"sphere\"\nradius = 1.0\n\
+             subdivisions = 5\n",
+        );
+        assert_eq!(
+            local_radius(&g, 0, DVec3::new(0.0, 0.0, 3.0), DVec3::Z),
+            None
+        );
+        let tilted = DVec3::new(0.5, 0.75f64.sqrt(), 0.0);
+        // Just outside the tessellated ball (its surface lies within the sphere), so the
+        // rays leaving away from it miss.
+        assert!(local_radius(&g, 0, DVec3::X * 1.001, tilted).is_some());
+    }
+
     #[test]
     fn an_open_surface_has_no_radius() {
         let g =
@@ -258,6 +278,8 @@ mod tests {
         // A normal that is no direction neither.
         let g = geometry("[[objects]]\nmaterial = \"skin\"\nshape = \"sphere\"\nradius = 1.0\n");
         assert_eq!(local_radius(&g, 0, DVec3::X, DVec3::ZERO), None);
+        // From the centre, where every ray in any direction would meet the ball.
+        assert_eq!(local_radius(&g, 0, DVec3::ZERO, DVec3::ZERO), None);
         assert_eq!(local_radius(&g, 0, DVec3::X, DVec3::splat(f64::NAN)), None);
     }
 }

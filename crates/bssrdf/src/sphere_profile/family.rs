@@ -132,12 +132,12 @@ impl BallFamily {
         if !(r <= 2.0 * radius) {
             return [0.0; 3];
         }
-        // (node, weight, scale) of the one or two nodes read.
+        // (node, weight, scale) of the one or two nodes read: the first `n` of `reads`.
         let i = self.nodes.partition_point(|n| n.0 <= radius);
-        let reads: [(usize, f64, f64); 2] = if i == 0 {
-            [(0, 1.0, 1.0), (0, 0.0, 1.0)]
+        let (reads, n) = if i == 0 {
+            ([(0, 1.0, 1.0); 2], 1)
         } else if i == self.nodes.len() {
-            [(i - 1, 1.0, 1.0), (i - 1, 0.0, 1.0)]
+            ([(i - 1, 1.0, 1.0); 2], 1)
         } else {
             let (a, b) = (self.nodes[i - 1].0, self.nodes[i].0);
             let t = (radius / a).ln() / (b / a).ln();
@@ -146,15 +146,14 @@ impl BallFamily {
             } else {
                 0.0
             };
-            [(i - 1, 1.0 - t, a / radius), (i, t, b / radius)]
+            ([(i - 1, 1.0 - t, a / radius), (i, t, b / radius)], 2)
         };
         std::array::from_fn(|ch| {
             if !channels[ch] {
                 return 0.0;
             }
-            let delta: f64 = reads
+            let delta: f64 = reads[..n]
                 .iter()
-                .filter(|(_, w, _)| *w != 0.0)
                 .map(|&(k, w, s)| w * s * s * self.nodes[k].1.delta(ch, r * s))
                 .sum();
             let v = rd[ch] + delta;
@@ -189,6 +188,27 @@ mod tests {
         assert!(BallFamily::new(&skin1(), 0.0, 1.0).is_err());
         assert!(BallFamily::new(&skin1(), 2.0, 1.0).is_err());
         assert!(BallFamily::new(&skin1(), 1.0, f64::INFINITY).is_err());
+    }
+
+    /// A node's walk (its [`FAMILY_PHOTONS`]) returns the ball's total of the one-radius
+    /// profile's walk (four times the photons) within five standard errors of the two
+    /// (binomial: each photon escapes or not).
+    #[test]
+    fn a_nodes_walk_agrees_with_the_one_radius_walk() {
+        let m = skin1();
+        let f = BallFamily::new(&m, 4.0, 4.0).unwrap();
+        let one = SphereDelta::cached(&m, 4.0).unwrap();
+        let node = &f.nodes[0].1;
+        assert_eq!(node.radius(), 4.0);
+        for ch in 0..3 {
+            let (a, b) = (node.totals(ch).0, one.totals(ch).0);
+            let var = |p: f64, n: u64| p * (1.0 - p) / n as f64;
+            let se = (var(a, FAMILY_PHOTONS) + var(b, super::super::PHOTONS)).sqrt();
+            assert!(
+                (a - b).abs() < 5.0 * se && se < 0.01,
+                "channel {ch}: {a} vs {b}, se {se}"
+            );
+        }
     }
 
     #[test]

@@ -141,7 +141,9 @@ impl Integrator for Exact {
     }
 }
 
-/// The subsurface radiance leaving `g` towards the camera.
+/// The subsurface radiance leaving `g` towards the camera, with the material's one profile: a
+/// material that gives each point its own ball (`sphere_radius = "local"`) needs the radii of
+/// its frame ([`crate::local_radius::frame_balls`]) through [`shade_with`].
 pub fn shade(g: &GSample, shading: &TranslucentShading, samples: &ObjectSamples) -> Rgb {
     shade_with(g, shading, samples, None)
 }
