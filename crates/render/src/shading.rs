@@ -301,22 +301,20 @@ impl TranslucentShading {
 
     /// [`add_point_sum`](Self::add_point_sum) with each pair's own ball
     /// ([`crate::local_radius`]): the sample's R_d ([`rd_sample_scene`](Self::rd_sample_scene))
-    /// reshaped by `family` to the ball of radius √(R_x R_i) (mm), `radius_x` the shading
-    /// point's radius and each point's last field its own (NaN: the half-space's profile).
+    /// reshaped by `family` to the ball of each point's last field, the pair's radius √(R_x R_i)
+    /// in mm (NaN: the half-space's profile).
     pub fn add_point_sum_local(
         &self,
         acc: &mut Rgb,
         x: DVec3,
-        radius_x: f64,
         family: &sss_bssrdf::BallFamily,
         points: impl IntoIterator<Item = (DVec3, f64, Rgb, f64)>,
     ) {
         let u = self.units_per_mm;
         let [s, _, _] = scene_unit_factors(u);
-        for (position, area, e, radius_i) in points {
+        for (position, area, e, radius) in points {
             let r = (position - x).length();
             let rd = self.rd_sample_scene(r, area);
-            let radius = (radius_x * radius_i).sqrt();
             let v = family.reshape_rgb(r / u, radius, rd.map(|v| v / s));
             for c in 0..3 {
                 acc[c] += v[c] * s * e[c] * area;

@@ -54,17 +54,13 @@ impl BallFamily {
         if self.drifts.is_empty() || !(radius > 0.0) || radius.is_nan() {
             return None;
         }
-        let i = self.nodes.partition_point(|n| n.0 <= radius);
-        // Past the last node, or nearer the one below in ln R than the one above: the one
-        // below; else the one above.
-        let k = if i == 0 {
-            0
-        } else if i == self.nodes.len()
-            || (radius / self.nodes[i - 1].0).ln() <= (self.nodes[i].0 / radius).ln()
-        {
-            i - 1
+        // The one node read, or of the two the one with the larger weight (the lower on a
+        // tie): the nearer in ln R.
+        let (reads, n) = self.reads(radius);
+        let k = if n == 2 && reads[1].1 > 0.5 {
+            reads[1].0
         } else {
-            i
+            reads[0].0
         };
         self.drifts.get(k).map(Arc::as_ref)
     }
@@ -114,17 +110,11 @@ impl BallFamily {
     /// nothing. Radii outside the nodes read the end node as it is (a family covers the radii
     /// its caller asks for; a scaling far outside it would not be bounded).
     pub fn reshape(&self, ch: usize, r: f64, radius: f64, rd: f64) -> f64 {
-        let mut v = [0.0; 3];
-        v[ch] = rd;
-        self.reshape_channels(r, radius, v, [ch == 0, ch == 1, ch == 2])[ch]
+        self.reshape_rgb(r, radius, [rd; 3])[ch]
     }
 
     /// [`BallFamily::reshape`] of the three channels at once (the nodes found once).
     pub fn reshape_rgb(&self, r: f64, radius: f64, rd: Rgb) -> Rgb {
-        self.reshape_channels(r, radius, rd, [true; 3])
-    }
-
-    fn reshape_channels(&self, r: f64, radius: f64, rd: Rgb, channels: [bool; 3]) -> Rgb {
         if !(radius > 0.0) || radius.is_nan() {
             return rd;
         }
@@ -132,9 +122,24 @@ impl BallFamily {
         if !(r <= 2.0 * radius) {
             return [0.0; 3];
         }
-        // (node, weight, scale) of the one or two nodes read: the first `n` of `reads`.
+        let (reads, n) = self.reads(radius);
+        std::array::from_fn(|ch| {
+            let delta: f64 = reads[..n]
+                .iter()
+                .map(|&(k, w, s)| w * s * s * self.nodes[k].1.delta(ch, r * s))
+                .sum();
+            let v = rd[ch] + delta;
+            if v.is_finite() { v.max(0.0) } else { 0.0 }
+        })
+    }
+
+    /// The nodes a ball of `radius` (mm, > 0) reads, as (node, weight, scale): the first `n`
+    /// of the pair. Outside the nodes the end node, weight 1, unscaled; between two nodes a
+    /// and b each weighted linearly in ln R, scaled by a/R and b/R
+    /// ([`BallFamily::reshape`]).
+    fn reads(&self, radius: f64) -> ([(usize, f64, f64); 2], usize) {
         let i = self.nodes.partition_point(|n| n.0 <= radius);
-        let (reads, n) = if i == 0 {
+        if i == 0 {
             ([(0, 1.0, 1.0); 2], 1)
         } else if i == self.nodes.len() {
             ([(i - 1, 1.0, 1.0); 2], 1)
@@ -147,18 +152,7 @@ impl BallFamily {
                 0.0
             };
             ([(i - 1, 1.0 - t, a / radius), (i, t, b / radius)], 2)
-        };
-        std::array::from_fn(|ch| {
-            if !channels[ch] {
-                return 0.0;
-            }
-            let delta: f64 = reads[..n]
-                .iter()
-                .map(|&(k, w, s)| w * s * s * self.nodes[k].1.delta(ch, r * s))
-                .sum();
-            let v = rd[ch] + delta;
-            if v.is_finite() { v.max(0.0) } else { 0.0 }
-        })
+        }
     }
 }
 

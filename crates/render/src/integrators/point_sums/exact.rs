@@ -23,12 +23,12 @@ use crate::integrators::options::sample_settings;
 use crate::integrators::{
     Integrator, Layer, Method, MethodOptions, Shaded, Stat, Sweep, add_weighted,
 };
-use crate::irradiance::{IrradianceSettings, ObjectSamples};
+use crate::irradiance::{IrradianceSample, IrradianceSettings, ObjectSamples};
 use crate::local_radius::{FrameBalls, LocalBalls, frame_balls};
 use crate::progress::Progress;
 use crate::shading::TranslucentShading;
 use rayon::prelude::*;
-use sss_bssrdf::{Rgb, SurfacePoint};
+use sss_bssrdf::{EntryDrift, Rgb, SurfacePoint};
 
 /// The irradiance-sample spacing (mean free paths) of `cargo xtask compare`'s reference: the
 /// default, or twice it with `--quick`.
@@ -184,55 +184,48 @@ pub fn shade_with(
         }
         return sum;
     }
-    if let Some((balls, radius)) = ball {
-        // Each pair's ball, and a drifting material's drift in that ball.
-        let family = &balls.family;
-        shading.add_point_sum_local(
+    // A drifting material's irradiance depends on the shading point: each sample's packets,
+    // each moved by the drift towards g ([`TranslucentShading::entering_towards`]); with each
+    // point's own ball, by the drift of the pair's ball.
+    let toward_g = |i: usize, s: &IrradianceSample, drift: Option<&EntryDrift>| match drift {
+        Some(d) => shading.entering_towards_with(
+            Some(d),
+            samples.incident_of(i),
+            (s.position, s.normal),
+            (g.p, g.n, g.wo),
+        ),
+        None => s.irradiance,
+    };
+    match ball {
+        Some((balls, radius)) => shading.add_point_sum_local(
             &mut sum,
             g.p,
-            radius,
-            family,
+            &balls.family,
             samples
                 .samples
                 .iter()
                 .zip(&balls.samples)
                 .enumerate()
-                .map(|(i, (s, &r))| {
-                    let e = match family.drift((radius * r).sqrt()) {
-                        Some(d) => shading.entering_towards_with(
-                            Some(d),
-                            samples.incident_of(i),
-                            (s.position, s.normal),
-                            (g.p, g.n, g.wo),
-                        ),
-                        None => s.irradiance,
-                    };
-                    (s.position, s.area, e, r)
+                .map(|(i, (s, &ri))| {
+                    let pair = (radius * ri).sqrt();
+                    (
+                        s.position,
+                        s.area,
+                        toward_g(i, s, balls.family.drift(pair)),
+                        pair,
+                    )
                 }),
-        );
-        let mut out = [0.0; 3];
-        add_weighted(&mut out, sum, shading.exit_weights(g.n, g.wo));
-        return out;
+        ),
+        None => shading.add_point_sum(
+            &mut sum,
+            g.p,
+            samples
+                .samples
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (s.position, s.area, toward_g(i, s, shading.drift.as_deref()))),
+        ),
     }
-    // A drifting material's irradiance depends on the shading point: each sample's packets,
-    // each moved by the drift towards g ([`TranslucentShading::entering_towards`]).
-    let drift = shading.drift.is_some();
-    shading.add_point_sum(
-        &mut sum,
-        g.p,
-        samples.samples.iter().enumerate().map(|(i, s)| {
-            let e = if drift {
-                shading.entering_towards(
-                    samples.incident_of(i),
-                    (s.position, s.normal),
-                    (g.p, g.n, g.wo),
-                )
-            } else {
-                s.irradiance
-            };
-            (s.position, s.area, e)
-        }),
-    );
     let mut out = [0.0; 3];
     add_weighted(&mut out, sum, shading.exit_weights(g.n, g.wo));
     out
