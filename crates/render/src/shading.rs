@@ -163,6 +163,10 @@ pub struct TranslucentShading {
     pub local_radius: bool,
     /// `drift = true` with `sphere_radius = "local"`: each pair's ball drifts.
     pub local_drift: bool,
+    /// The one ball's radius in mm where the material's profile is a ball's (`sphere_radius` a
+    /// number or `"auto"`, [`SphereProfile`]): its profile is tabulated and ends at the ball's
+    /// diameter.
+    pub ball_mm: Option<f64>,
     /// The disk-average quadrature of [`rd_sample_scene`](Self::rd_sample_scene).
     disk: DiskRule,
 }
@@ -227,6 +231,10 @@ impl TranslucentShading {
             drift,
             local_radius: local,
             local_drift: local && t.drift,
+            ball_mm: t
+                .sphere_radius
+                .filter(|_| !local && t.model != ModelKind::DirectionalDipole)
+                .map(|r| r / t.units_per_mm),
             disk,
         }
     }
@@ -310,16 +318,32 @@ impl TranslucentShading {
         family: &sss_bssrdf::BallFamily,
         points: impl IntoIterator<Item = (DVec3, f64, Rgb, f64)>,
     ) {
-        let u = self.units_per_mm;
-        let [s, _, _] = scene_unit_factors(u);
         for (position, area, e, radius) in points {
-            let r = (position - x).length();
-            let rd = self.rd_sample_scene(r, area);
-            let v = family.reshape_rgb(r / u, radius, rd.map(|v| v / s));
+            let v = self.rd_sample_ball((position - x).length(), area, family, radius);
             for c in 0..3 {
-                acc[c] += v[c] * s * e[c] * area;
+                acc[c] += v[c] * e[c] * area;
             }
         }
+    }
+
+    /// [`rd_sample_scene`](Self::rd_sample_scene) reshaped by `family` to the ball of
+    /// `radius` mm (NaN: the half-space's profile, unchanged), per scene unit²: one pair's
+    /// term of [`add_point_sum_local`](Self::add_point_sum_local), and the trees' value for a
+    /// node whose samples share one ball.
+    #[inline]
+    pub fn rd_sample_ball(
+        &self,
+        r: f64,
+        area: f64,
+        family: &sss_bssrdf::BallFamily,
+        radius: f64,
+    ) -> Rgb {
+        let u = self.units_per_mm;
+        let [s, _, _] = scene_unit_factors(u);
+        let rd = self.rd_sample_scene(r, area);
+        family
+            .reshape_rgb(r / u, radius, rd.map(|v| v / s))
+            .map(|v| v * s)
     }
 
     /// The far branch of [`rd_sample_scene`](Self::rd_sample_scene) with its first two
@@ -609,12 +633,14 @@ impl TranslucentShading {
     }
 
     /// Ok unless the material gives each point its own ball (`sphere_radius = "local"`),
-    /// which only `exact` reads; otherwise an error naming the material and `method`.
+    /// which only `exact`, `single-tree` and `dual-tree-fmm` read; otherwise an error naming
+    /// the material and `method`.
     pub fn one_profile(&self, method: &str) -> Result<(), crate::Error> {
         if self.local_radius {
             Err(crate::Error::Unsupported(format!(
                 "material `{}`: method {method} takes one profile per material; \
-                 `sphere_radius = \"local\"` gives each pair of points its own ball (use exact)",
+                 `sphere_radius = \"local\"` gives each pair of points its own ball (use \
+                 exact, single-tree or dual-tree-fmm)",
                 self.name
             )))
         } else {
@@ -625,15 +651,27 @@ impl TranslucentShading {
     /// Ok when the material neither drifts nor gives each point its own ball
     /// (`sphere_radius = "local"`); otherwise an error naming the material and `method`, which
     /// sums one irradiance per point with one profile (only `exact` and `pathtrace` keep each
-    /// packet's direction; only `exact` each point's radius).
+    /// packet's direction; only `exact` and the point-sum trees each point's radius).
     pub fn no_drift(&self, method: &str) -> Result<(), crate::Error> {
         self.one_profile(method)?;
-        if self.drift.is_none() {
+        self.one_irradiance(method)
+    }
+
+    /// Ok unless the material drifts (`drift = true`, with one ball or each point's own);
+    /// otherwise an error naming the material and `method`, which sums one irradiance per
+    /// point (only `exact`, and `pathtrace` with one profile, keep each packet's direction).
+    pub fn one_irradiance(&self, method: &str) -> Result<(), crate::Error> {
+        if self.drift.is_none() && !self.local_drift {
             Ok(())
         } else {
+            let instead = if self.local_radius {
+                "exact"
+            } else {
+                "exact or pathtrace"
+            };
             Err(crate::Error::Unsupported(format!(
                 "material `{}`: method {method} sums one irradiance per point; `drift = true` \
-                 needs each light's direction at each point (use exact or pathtrace)",
+                 needs each light's direction at each point (use {instead})",
                 self.name
             )))
         }

@@ -79,11 +79,15 @@ pub(crate) fn write_plot(path: &Path, case: &str, runs: &[TruthRun]) -> Result<(
         .with_style(SeriesStyle::LineMarkers)
         .with_color([0, 0, 0]),
     );
-    for (i, name) in FAST.into_iter().enumerate() {
-        let p = points(&|r| r.method == name);
+    let fast = FAST
+        .iter()
+        .map(|&name| (name, FAST_MODEL.name()))
+        .chain(LOCAL_FAST.iter().map(|&name| (name, LOCAL_FAST_MODEL)));
+    for (i, (name, model)) in fast.enumerate() {
+        let p = points(&|r| r.method == name && r.model == model);
         if !p.is_empty() {
             series.push(
-                Series::line(format!("{name} ({})", FAST_MODEL.name()), p)
+                Series::line(format!("{name} ({model})"), p)
                     .with_style(SeriesStyle::LineMarkers)
                     .with_color(colour(i)),
             );
@@ -103,7 +107,7 @@ pub(crate) fn write_plot(path: &Path, case: &str, runs: &[TruthRun]) -> Result<(
             series.push(
                 Series::line(format!("Cycles {}", mode.name()), p)
                     .with_style(SeriesStyle::Dashed)
-                    .with_color(colour(FAST.len() + i)),
+                    .with_color(colour(FAST.len() + LOCAL_FAST.len() + i)),
             );
         }
     }

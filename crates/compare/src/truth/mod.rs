@@ -7,7 +7,8 @@
 //! - every model under `exact` (its sum) and under `pathtrace` (the integral that sum
 //!   discretises, its own noise removed: the model's floor against the truth);
 //! - the fast methods (`dual-tree-fmm`, `manylight`, `separable`) over their sweeps, with
-//!   `mc-table`;
+//!   `mc-table`, and `dual-tree-fmm` with each point's own ball too
+//!   (`mc-table+albedo+local`);
 //! - `volpath` at increasing paths per pixel, with another seed, on the same axes, so the
 //!   report reads off for each method and model the time at which brute force reaches the same
 //!   error ([`Crossover`]).
@@ -48,7 +49,10 @@ use plan::{
     Case, Plan, plan, with_albedo_weights, with_ball_profile, with_drift, with_local_balls,
 };
 use report::{CaseResult, section, truth_csv};
-use runs::{EXACT_SAMPLES, FAST, FAST_MODEL, PATHTRACE_SPP, TruthRun, run_case};
+use runs::{
+    EXACT_SAMPLES, FAST, FAST_MODEL, LOCAL_FAST, LOCAL_FAST_MODEL, PATHTRACE_SPP, TruthRun,
+    run_case,
+};
 use scoring::{Crossover, Score, score, score_without_noise};
 use sss_bssrdf::{Medium, ModelKind, Rgb};
 use sss_plot::{PALETTE, Series, SeriesStyle, write_signed_map};

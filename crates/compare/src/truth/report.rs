@@ -92,7 +92,8 @@ pub(crate) fn section(
         "Every BSSRDF model against real light transport: `volpath`, volumetric path tracing \
          of the medium in the mesh (checked against Mitsuba 3 and MCML), rendered until its own \
          relative noise is small; every model under `exact` (its sum) and `pathtrace` (the \
-         integral it discretises), the fast methods with `mc-table` over their sweeps, and \
+         integral it discretises), the fast methods with `mc-table` over their sweeps \
+         (`dual-tree-fmm` with `mc-table+albedo+local` too: each point's own ball), and \
          `volpath` at fewer paths, all scored \
          over the pixels inside the silhouette (a pixel and its eight neighbours covered) with \
          the reference's noise removed. *volpath to the same \

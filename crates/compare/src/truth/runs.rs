@@ -1,5 +1,6 @@
 //! The runs of one case, each scored against its reference: every model under `exact`, the
-//! fast methods over their sweeps (with `mc-table`, the model the scene files name), and
+//! fast methods over their sweeps (with `mc-table`, the model the scene files name, and those
+//! that take it with each point's own ball), and
 //! `volpath` itself over its paths per pixel (with another seed than the reference's, so its
 //! error is its own noise).
 
@@ -36,6 +37,14 @@ pub const DRIFT_MODEL: &str = "mc-table+albedo+ball+drift";
 /// drift in each pair's ball (`drift = true`) in the runs' `model` column. Only `exact` renders
 /// it.
 pub const LOCAL_MODEL: &str = "mc-table+albedo+local+drift";
+
+/// The name of [`ALBEDO_MODEL`] with each point's own ball (`sphere_radius = "local"`) and no
+/// drift in the runs' `model` column: the model [`LOCAL_FAST`] sweep too.
+pub const LOCAL_FAST_MODEL: &str = "mc-table+albedo+local";
+
+/// The fast methods that take each point's own ball, swept with [`LOCAL_FAST_MODEL`] besides
+/// [`FAST_MODEL`].
+pub const LOCAL_FAST: [&str; 1] = ["dual-tree-fmm"];
 
 /// The models beyond [`ModelKind::ALL`] the experiment scores, in report order.
 pub const VARIANTS: [&str; 4] = [ALBEDO_MODEL, BALL_MODEL, DRIFT_MODEL, LOCAL_MODEL];
@@ -206,26 +215,39 @@ pub(crate) fn run_case(
         run.floor = Some(score_without_noise(&r.subsurface, &se, truth).rel_rmse);
         out.runs.push(run);
     }
-    // The fast methods over their sweeps.
+    // The fast methods over their sweeps, with the scene files' model; those that take each
+    // point's own ball, with it too.
     if plan.fast {
-        let scene = scene_for(FAST_MODEL)?;
-        for name in FAST {
+        let plain = scene_for(FAST_MODEL)?;
+        let mut local = scene_for(FAST_MODEL)?;
+        with_albedo_weights(&mut local);
+        with_local_balls(&mut local);
+        let jobs = FAST
+            .iter()
+            .map(|&name| (name, &plain, FAST_MODEL.name()))
+            .chain(
+                LOCAL_FAST
+                    .iter()
+                    .map(|&name| (name, &local, LOCAL_FAST_MODEL)),
+            );
+        for (name, scene, model) in jobs {
             let m = integrators::method(name).map_err(|e| Error(e.to_string()))?;
             for v in (m.sweep.values)(cfg.quick) {
                 let method =
                     integrators::build(name, &MethodOptions::new().with(m.sweep.option, v))
                         .map_err(|e| Error(e.to_string()))?;
-                match render(&scene, method.as_ref(), &settings(cfg.seed), &NoProgress) {
-                    Ok(r) => out
-                        .runs
-                        .push(row(m.name, FAST_MODEL.name(), m.sweep.label, v, &r)),
+                match render(scene, method.as_ref(), &settings(cfg.seed), &NoProgress) {
+                    Ok(r) => out.runs.push(row(m.name, model, m.sweep.label, v, &r)),
                     Err(sss_render::Error::Unsupported(why)) => {
                         out.unsupported
-                            .push(format!("`{name}` on `{}`: {why}", case.name()));
+                            .push(format!("`{name}` with {model} on `{}`: {why}", case.name()));
                         break;
                     }
                     Err(e) => {
-                        return Err(Error(format!("truth {}: {name}: {e}", case.name())));
+                        return Err(Error(format!(
+                            "truth {}: {name} with {model}: {e}",
+                            case.name()
+                        )));
                     }
                 }
             }

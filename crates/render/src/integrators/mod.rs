@@ -263,3 +263,16 @@ pub(crate) fn check_radial(frame: &Frame<'_>, method: &str) -> Result<(), Error>
     }
     check_no_drift(frame, method)
 }
+
+/// [`check_radial`] for the methods that take each point's own ball
+/// (`sphere_radius = "local"`): errors unless every visible translucent material is radial and
+/// does not drift.
+pub(crate) fn check_radial_balls(frame: &Frame<'_>, method: &str) -> Result<(), Error> {
+    for &o in &frame.visible {
+        if let Some(sh) = frame.shading_of(o) {
+            sh.radial(method)?;
+            sh.one_irradiance(method)?;
+        }
+    }
+    Ok(())
+}

@@ -102,9 +102,9 @@
 //! end, so results do not depend on the thread count. Radial models only.
 
 use super::{
-    Counts, ObjectPoints, PIXEL_LEAF, TASK_ITEMS, accepts, add_samples, eps_sweep,
-    for_each_dual_object, illumination_tree_bytes, illumination_trees, pixel_point, pixel_trees,
-    rd_times, shading_points, task_slices,
+    Counts, ObjectPoints, PIXEL_LEAF, TASK_ITEMS, TreeBalls, accepts, add_samples, ball_outputs,
+    eps_sweep, for_each_dual_object, illumination_tree_bytes, illumination_trees, node_balls,
+    pair_ball, pixel_point, pixel_trees, rd_times, shading_points, task_slices, tree_balls,
 };
 use crate::Error;
 use crate::frame::Frame;
@@ -114,9 +114,10 @@ use crate::integrators::options::{
 };
 use crate::integrators::{
     Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep, add_scaled,
-    add_weighted, check_radial,
+    add_weighted, check_radial_balls,
 };
 use crate::irradiance::IrradianceSettings;
+use crate::local_radius::frame_balls;
 use crate::progress::Progress;
 use crate::shading::{DISK_FAR_RATIO, TranslucentShading};
 use glam::DVec3;
@@ -351,7 +352,19 @@ struct Task<'s> {
     sample_expansions: u64,
 }
 
+/// One object's balls as the FMM reads them (`sphere_radius = "local"`).
+struct FmmBalls<'a> {
+    /// The illumination tree's.
+    tree: &'a TreeBalls<'a>,
+    /// Per shading point in the pixel tree's order, its radius (mm; NaN: none).
+    points: Vec<f64>,
+    /// Per pixel-tree node, the radius that stands for its points ([`node_balls`]).
+    nodes: Vec<Option<f64>>,
+}
+
 struct Fmm<'a> {
+    /// Each point's own ball, if the material gives one.
+    balls: Option<FmmBalls<'a>>,
     px: &'a PixelTree,
     irr: &'a IrradianceTree,
     /// Shading points in the pixel tree's order.
@@ -368,6 +381,69 @@ struct Fmm<'a> {
 }
 
 impl Fmm<'_> {
+    /// The ball radius (mm) that stands for illumination node `i`'s samples: NaN with one
+    /// profile or where none has one, `None` where the node must be split ([`node_balls`]).
+    fn source_ball(&self, i: u32) -> Option<f64> {
+        match &self.balls {
+            Some(b) => b.tree.nodes[i as usize],
+            None => Some(f64::NAN),
+        }
+    }
+
+    /// [`Self::source_ball`] of pixel node `s`'s shading points.
+    fn pixel_ball(&self, s: u32) -> Option<f64> {
+        match &self.balls {
+            Some(b) => b.nodes[s as usize],
+            None => Some(f64::NAN),
+        }
+    }
+
+    /// The radius (mm) of the `k`-th shading point in the pixel tree's order (NaN: none).
+    fn point_ball(&self, k: usize) -> f64 {
+        self.balls
+            .as_ref()
+            .and_then(|b| b.points.get(k).copied())
+            .unwrap_or(f64::NAN)
+    }
+
+    /// The point value of a source of `area` at distance `r` with the pair's ball `pair`
+    /// (NaN: the half-space's profile).
+    fn value(&self, r: f64, area: f64, pair: f64) -> Rgb {
+        match &self.balls {
+            Some(b) if !pair.is_nan() => self.sh.rd_sample_ball(r, area, b.tree.family, pair),
+            _ => self.sh.rd_sample_scene(r, area),
+        }
+    }
+
+    /// The radius (mm) of the irradiance sample at `j` in the illumination tree's leaf order
+    /// (NaN: none).
+    fn sample_ball(&self, j: usize) -> f64 {
+        self.balls
+            .as_ref()
+            .and_then(|b| b.tree.samples.get(j).copied())
+            .unwrap_or(f64::NAN)
+    }
+
+    /// Adds sample `p` (at `j` in the illumination tree's leaf order) at the `k`-th shading
+    /// point, as `exact` sums it (with the pair's own ball, if the material gives one).
+    fn add_sample_at(&self, acc: &mut Rgb, j: usize, p: &IrradiancePoint, k: usize) {
+        let x = self.points[k].position;
+        match &self.balls {
+            Some(b) => self.sh.add_point_sum_local(
+                acc,
+                x,
+                b.tree.family,
+                [(
+                    p.position,
+                    p.area,
+                    p.irradiance,
+                    pair_ball(self.point_ball(k), self.sample_ball(j)),
+                )],
+            ),
+            None => add_samples(acc, std::slice::from_ref(p), x, self.sh),
+        }
+    }
+
     /// The tests of the module docs for the pair (S, I) at `dn`, the distance from the
     /// source's position to S's nearest point.
     fn tests(&self, s: u32, i: u32, dn: f64) -> PairTests {
@@ -397,11 +473,17 @@ impl Fmm<'_> {
         let rs = self.px_radius[s as usize];
         let delta = sc.position - cl.position;
         let dn = delta.length() - rs;
-        let ok = self.tests(s, i, dn);
+        let mut ok = self.tests(s, i, dn);
+        // With each point's own ball, a node whose radii spread too widely for one to stand
+        // for them is split as one too wide is.
+        let source_ball = self.source_ball(i);
+        let pixel_ball = self.pixel_ball(s);
+        ok.source &= source_ball.is_some();
         // Both sides small: the cluster's expansion about S (multipole to local).
         if ok.source
             && ok.pixels
-            && let Some(rd) = self.expansion(rs, delta, cl.area, false)
+            && let (Some(a), Some(b)) = (source_ball, pixel_ball)
+            && let Some(rd) = self.expansion(rs, delta, cl.area, false, pair_ball(a, b))
         {
             self.add_expansion(s, delta, &rd, cl.flux, t);
             t.clusters += 1;
@@ -412,9 +494,11 @@ impl Fmm<'_> {
         // single tree would (multipole to point); an inner node is split.
         if ok.source {
             if sn.is_leaf() {
+                let ball = source_ball.unwrap_or(f64::NAN);
                 for k in sn.start as usize..sn.end as usize {
                     let x = self.points[k].position;
-                    let rd = self.sh.rd_sample_scene((cl.position - x).length(), cl.area);
+                    let pair = pair_ball(ball, self.point_ball(k));
+                    let rd = self.value((cl.position - x).length(), cl.area, pair);
                     add_scaled(&mut t.acc[k - t.start], rd_times(rd, cl.flux), 1.0);
                 }
                 t.clusters += sn.len() as u64;
@@ -474,8 +558,48 @@ impl Fmm<'_> {
     /// diffusion profiles without their exponential) 2λ = r and the test is the geometric
     /// one; where the exponential dominates, λ → 1/σ and the test bounds the σ r_S part of the
     /// remainder.
-    fn expansion(&self, rs: f64, delta: DVec3, area: f64, near: bool) -> Option<[[f64; 3]; 3]> {
+    ///
+    /// With a pair's ball `pair` (mm; NaN: the material's own profile), or with the material's
+    /// one ball ([`TranslucentShading::ball_mm`]), the profile is the ball's
+    /// ([`TranslucentShading::rd_sample_ball`]), and its coefficients are those of
+    /// the quadratic through its values at ‖delta‖ and ‖delta‖ ± r_S (central differences one
+    /// node radius apart: the ball's difference is tabulated, linear between its bins), so the
+    /// expansion interpolates the profile over the node's own radial extent; refused where
+    /// that extent straddles the ball's diameter, where the profile ends.
+    fn expansion(
+        &self,
+        rs: f64,
+        delta: DVec3,
+        area: f64,
+        near: bool,
+        pair: f64,
+    ) -> Option<[[f64; 3]; 3]> {
         let mut rd = self.passing_derivatives(rs, delta, area, near)?;
+        // A material with one ball has a ball's profile too (tabulated, ending at its
+        // diameter): the same interpolation, over its value.
+        let pair = if pair.is_nan() {
+            self.sh.ball_mm.unwrap_or(f64::NAN)
+        } else {
+            pair
+        };
+        if !pair.is_nan() {
+            let r = delta.length();
+            let h = rs.max(1e-6 * r);
+            let end = 2.0 * pair * self.sh.units_per_mm;
+            if !(r - h > 0.0) || (r - h < end && end <= r + h) {
+                return None;
+            }
+            let [lo, mid, hi] = [r - h, r, r + h].map(|x| self.value(x, area, pair));
+            let c = 1.0 / (h * h);
+            let d = 0.5 / h;
+            return Some(std::array::from_fn(|ch| {
+                [
+                    mid[ch],
+                    (hi[ch] - lo[ch]) * d,
+                    (hi[ch] - 2.0 * mid[ch] + lo[ch]) * c,
+                ]
+            }));
+        }
         if near {
             // The value is the disk average's already.
             return Some(rd);
@@ -544,9 +668,14 @@ impl Fmm<'_> {
             return false;
         }
         let centre = self.px.clusters[s as usize].position;
+        let Some(ball) = self.pixel_ball(s) else {
+            return false;
+        };
+        let first = self.irr.tree.nodes[i as usize].start as usize;
         let mut coefficients = [[[0.0; 3]; 3]; MOST];
-        for (p, rd) in pts.iter().zip(&mut coefficients) {
-            match self.expansion(rs, centre - p.position, p.area, true) {
+        for (j, (p, rd)) in pts.iter().zip(&mut coefficients).enumerate() {
+            let pair = pair_ball(ball, self.sample_ball(first + j));
+            match self.expansion(rs, centre - p.position, p.area, true, pair) {
                 Some(x) => *rd = x,
                 None => return false,
             }
@@ -570,21 +699,19 @@ impl Fmm<'_> {
         let pts = self.irr.points_of(&self.irr.tree.nodes[i as usize]);
         let centre = self.px.clusters[s as usize].position;
         // An expansion costs about what a few point evaluations do: not worth trying for a
-        // node of fewer points.
-        let try_expansions = sn.len() >= EXPAND_MIN_POINTS;
-        for p in pts {
+        // node of fewer points (nor for one whose points do not share one ball).
+        let ball = self.pixel_ball(s);
+        let try_expansions = sn.len() >= EXPAND_MIN_POINTS && ball.is_some();
+        let first = self.irr.tree.nodes[i as usize].start as usize;
+        for (j, p) in pts.iter().enumerate() {
             let delta = centre - p.position;
-            if try_expansions && let Some(rd) = self.expansion(rs, delta, p.area, true) {
+            let pair = pair_ball(ball.unwrap_or(f64::NAN), self.sample_ball(first + j));
+            if try_expansions && let Some(rd) = self.expansion(rs, delta, p.area, true, pair) {
                 self.add_sample_expansion(s, delta, &rd, p, t);
                 continue;
             }
             for k in sn.start as usize..sn.end as usize {
-                add_samples(
-                    &mut t.acc[k - t.start],
-                    std::slice::from_ref(p),
-                    self.points[k].position,
-                    self.sh,
-                );
+                self.add_sample_at(&mut t.acc[k - t.start], first + j, p, k);
             }
             t.samples += sn.len() as u64;
         }
@@ -721,9 +848,11 @@ impl Integrator for DualTreeFmm {
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
-        check_radial(frame, METHOD.name)?;
+        check_radial_balls(frame, METHOD.name)?;
         let samples = frame.irradiance_samples(&self.irradiance);
+        let balls = frame_balls(frame, &frame.samples_by_object(&samples))?;
         let trees = frame.timed("illumination_tree", || illumination_trees(frame, &samples));
+        let tree_balls = tree_balls(&balls, &trees);
         let points = if self.cap_rho > 0.0 {
             frame.timed("fourier", || shading_points(frame))?
         } else {
@@ -738,7 +867,19 @@ impl Integrator for DualTreeFmm {
                 let (sh, px, irr) = (obj.sh, obj.px, obj.irr);
                 let mut acc = vec![[0.0; 3]; obj.ordered.len()];
                 if !irr.tree.nodes.is_empty() && !px.tree.nodes.is_empty() {
+                    let fmm_balls = tree_balls[obj.object as usize].as_ref().map(|tree| {
+                        let points: Vec<f64> = (0..obj.ordered.len())
+                            .map(|k| balls.points.get(obj.sample(k)).copied().unwrap_or(f64::NAN))
+                            .collect();
+                        let nodes = node_balls(&px.tree, &points);
+                        FmmBalls {
+                            tree,
+                            points,
+                            nodes,
+                        }
+                    });
                     let fmm = Fmm {
+                        balls: fmm_balls,
                         px,
                         irr,
                         points: &obj.ordered,
@@ -801,9 +942,12 @@ impl Integrator for DualTreeFmm {
             name: "sample_expansions",
             value: sample_expansions.load(Ordering::Relaxed) as f64,
         });
+        let mut layers = Vec::new();
+        ball_outputs(frame, &balls, &mut stats, &mut layers);
         Ok(Shaded {
             values,
             stats,
+            layers,
             ..Shaded::default()
         })
     }

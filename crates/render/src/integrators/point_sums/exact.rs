@@ -20,9 +20,7 @@ use crate::gbuffer::GSample;
 use crate::integrators::Converges;
 use crate::integrators::options::SAMPLE_OPTIONS;
 use crate::integrators::options::sample_settings;
-use crate::integrators::{
-    Integrator, Layer, Method, MethodOptions, Shaded, Stat, Sweep, add_weighted,
-};
+use crate::integrators::{Integrator, Method, MethodOptions, Shaded, Stat, Sweep, add_weighted};
 use crate::irradiance::{IrradianceSample, IrradianceSettings, ObjectSamples};
 use crate::local_radius::{FrameBalls, LocalBalls, frame_balls};
 use crate::progress::Progress;
@@ -122,16 +120,7 @@ impl Integrator for Exact {
             value: evaluations as f64,
         }];
         let mut layers = Vec::new();
-        if balls.any() {
-            stats.push(Stat {
-                name: "ball_radii",
-                value: balls.nodes() as f64,
-            });
-            layers.push(Layer {
-                name: "local_radius",
-                pixels: balls.pixel_radii(frame),
-            });
-        }
+        super::ball_outputs(frame, &balls, &mut stats, &mut layers);
         Ok(Shaded {
             values,
             stats,

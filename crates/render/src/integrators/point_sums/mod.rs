@@ -12,18 +12,19 @@ pub mod dual_tree_fmm;
 pub mod exact;
 pub mod single_tree;
 
-use super::Stat;
+use super::{Layer, Stat};
 use crate::Error;
 use crate::frame::Frame;
 use crate::gbuffer::GSample;
 use crate::irradiance::ObjectSamples;
+use crate::local_radius::{FrameBalls, LocalBalls};
 use crate::sampling_rate::object_rates;
 pub use crate::sampling_rate::{curvature_at_hits, pixel_footprint};
 use crate::shading::TranslucentShading;
 use glam::DVec3;
 use rayon::prelude::*;
-use sss_bssrdf::Rgb;
-use sss_hierarchy::{IrradiancePoint, IrradianceTree, KdNode, PixelPoint, PixelTree};
+use sss_bssrdf::{BallFamily, Rgb};
+use sss_hierarchy::{IrradiancePoint, IrradianceTree, KdNode, KdTree, PixelPoint, PixelTree};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Irradiance samples per leaf of the illumination tree. Small, because a leaf that is not
@@ -143,6 +144,172 @@ pub(crate) fn add_samples(
     );
 }
 
+/// The widest spread of ball radii, ln(R_max / R_min), over which one radius (their geometric
+/// mean) stands for a tree node's points when each point has its own ball
+/// (`sphere_radius = "local"`): radii within a factor 2, so a pair's radius √(R_i R_o) errs by
+/// at most a factor √2 from a node's side, the ball family's node spacing. Measured against
+/// `exact` on the truth experiment's bunny, dragon and head (`docs/compare.md`): a spread of
+/// 0.2 costs 1.5–3 times the shading time for no error that shows (under 0.6 % relative RMSE
+/// either way), and no limit at all adds little.
+pub const BALL_SPREAD: f64 = std::f64::consts::LN_2;
+
+/// Per node of `tree`, the ball radius (mm) that stands for its points when each point has
+/// its own ball: their geometric mean where their radii `radii` (mm, in the tree's leaf
+/// order; NaN: none) spread by at most [`BALL_SPREAD`] in ln R, NaN where none of them has a
+/// radius (the half-space's profile), `None` where the node must be split (a wider spread, or
+/// points with and without a radius).
+pub(crate) fn node_balls<const D: usize>(tree: &KdTree<D>, radii: &[f64]) -> Vec<Option<f64>> {
+    #[derive(Clone, Copy)]
+    struct Span {
+        n: u32,
+        none: u32,
+        lo: f64,
+        hi: f64,
+        sum_ln: f64,
+    }
+    let empty = Span {
+        n: 0,
+        none: 0,
+        lo: f64::INFINITY,
+        hi: f64::NEG_INFINITY,
+        sum_ln: 0.0,
+    };
+    let spans = tree.bottom_up(
+        empty,
+        |node| {
+            let mut s = empty;
+            for &r in radii
+                .get(node.start as usize..node.end as usize)
+                .unwrap_or(&[])
+            {
+                s.n += 1;
+                if r.is_finite() && r > 0.0 {
+                    let l = r.ln();
+                    s.lo = s.lo.min(l);
+                    s.hi = s.hi.max(l);
+                    s.sum_ln += l;
+                } else {
+                    s.none += 1;
+                }
+            }
+            s
+        },
+        |a, b| Span {
+            n: a.n + b.n,
+            none: a.none + b.none,
+            lo: a.lo.min(b.lo),
+            hi: a.hi.max(b.hi),
+            sum_ln: a.sum_ln + b.sum_ln,
+        },
+    );
+    spans
+        .iter()
+        .map(|s| {
+            if s.none == s.n {
+                Some(f64::NAN)
+            } else if s.none > 0 || !(s.hi - s.lo <= BALL_SPREAD) {
+                None
+            } else {
+                Some((s.sum_ln / f64::from(s.n - s.none)).exp())
+            }
+        })
+        .collect()
+}
+
+/// The ball radius (mm) of a pair whose sides have radii `a` and `b`: √(a b), NaN when either
+/// has none (the half-space's profile; [`crate::local_radius`]).
+#[inline]
+pub(crate) fn pair_ball(a: f64, b: f64) -> f64 {
+    (a * b).sqrt()
+}
+
+/// One object's balls as the trees over its irradiance samples read them.
+pub(crate) struct TreeBalls<'a> {
+    /// The object's family of ball profiles.
+    pub(crate) family: &'a BallFamily,
+    /// Per irradiance sample in the illumination tree's leaf order, its radius (mm; NaN: none).
+    pub(crate) samples: Vec<f64>,
+    /// Per illumination-tree node, the radius that stands for its samples ([`node_balls`]).
+    pub(crate) nodes: Vec<Option<f64>>,
+}
+
+impl<'a> TreeBalls<'a> {
+    /// The balls of `tree`'s samples, from their object's `balls`.
+    pub(crate) fn new(tree: &IrradianceTree, balls: &'a LocalBalls) -> Self {
+        let samples: Vec<f64> = tree
+            .tree
+            .order
+            .iter()
+            .map(|&i| balls.samples.get(i as usize).copied().unwrap_or(f64::NAN))
+            .collect();
+        let nodes = node_balls(&tree.tree, &samples);
+        TreeBalls {
+            family: &balls.family,
+            samples,
+            nodes,
+        }
+    }
+
+    /// Adds the point sum at `x` (radius `rx` mm) of the samples of `node`, each pair with its
+    /// own ball ([`TranslucentShading::add_point_sum_local`], as `exact` sums them).
+    pub(crate) fn add_samples(
+        &self,
+        acc: &mut Rgb,
+        tree: &IrradianceTree,
+        node: &KdNode<3>,
+        x: DVec3,
+        rx: f64,
+        sh: &TranslucentShading,
+    ) {
+        let range = node.start as usize..node.end as usize;
+        sh.add_point_sum_local(
+            acc,
+            x,
+            self.family,
+            tree.points[range.clone()]
+                .iter()
+                .zip(&self.samples[range])
+                .map(|(p, &r)| (p.position, p.area, p.irradiance, pair_ball(rx, r))),
+        );
+    }
+}
+
+/// Per object (indexed by object), the [`TreeBalls`] of its illumination tree where its
+/// material gives each point its own ball.
+pub(crate) fn tree_balls<'a>(
+    balls: &'a FrameBalls,
+    trees: &[Option<IrradianceTree>],
+) -> Vec<Option<TreeBalls<'a>>> {
+    trees
+        .iter()
+        .enumerate()
+        .map(|(o, t)| {
+            let own = balls.objects.get(o)?.as_ref()?;
+            Some(TreeBalls::new(t.as_ref()?, own))
+        })
+        .collect()
+}
+
+/// The stat `ball_radii` and the layer `local_radius` of a frame whose materials give each
+/// point its own ball (nothing otherwise): `exact`'s and the trees' record of the balls.
+pub(crate) fn ball_outputs(
+    frame: &Frame<'_>,
+    balls: &FrameBalls,
+    stats: &mut Vec<Stat>,
+    layers: &mut Vec<Layer>,
+) {
+    if balls.any() {
+        stats.push(Stat {
+            name: "ball_radii",
+            value: balls.nodes() as f64,
+        });
+        layers.push(Layer {
+            name: "local_radius",
+            pixels: balls.pixel_radii(frame),
+        });
+    }
+}
+
 /// rd ⊙ flux.
 #[inline]
 pub(crate) fn rd_times(rd: Rgb, flux: [f64; 3]) -> Rgb {
@@ -215,6 +382,8 @@ pub(crate) struct DualObject<'a> {
     pub(crate) ordered: Vec<PixelPoint>,
     /// The G-buffer sample of each shading point, in the points' order before the tree.
     index: &'a [u32],
+    /// The object's index in the scene.
+    pub(crate) object: u32,
 }
 
 impl DualObject<'_> {
@@ -252,6 +421,7 @@ pub(crate) fn for_each_dual_object(
             px,
             ordered,
             index,
+            object: o,
         });
     }
     shaded
@@ -289,4 +459,81 @@ pub(crate) fn tasks(px: &PixelTree) -> Vec<u32> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A kd-tree over points on a line, leaves of `leaf` points, in the input's order (the
+    /// points are sorted, so the leaf order is the input's).
+    fn line(n: usize, leaf: usize) -> KdTree<1> {
+        let points: Vec<[f64; 1]> = (0..n).map(|i| [i as f64]).collect();
+        let tree = KdTree::build(&points, leaf);
+        assert!(tree.order.iter().enumerate().all(|(k, &i)| k == i as usize));
+        tree
+    }
+
+    /// A node's ball is the geometric mean of its points' radii while they spread by at most
+    /// BALL_SPREAD in ln R; wider, or with points with and without a radius, it has none; with
+    /// none having one, NaN (the half-space's profile).
+    #[test]
+    fn a_node_takes_one_ball_only_where_its_points_share_one() {
+        let tree = line(8, 2);
+        let root = 0;
+        let leaves: Vec<usize> = (0..tree.nodes.len())
+            .filter(|&k| tree.nodes[k].is_leaf())
+            .collect();
+        // Radii spreading by e^0.15 over the whole line: every node takes their mean.
+        let radii: Vec<f64> = (0..8)
+            .map(|i| 2.0 * (0.15 * i as f64 / 7.0).exp())
+            .collect();
+        let balls = node_balls(&tree, &radii);
+        let mean = 2.0 * (0.15f64 * 0.5).exp();
+        let b = balls[root].unwrap();
+        assert!((b / mean - 1.0).abs() < 1e-12, "{b} vs {mean}");
+        // Spread beyond BALL_SPREAD over the line (but not within a leaf of two): the root is
+        // split, each leaf has its own ball, between its two radii.
+        let radii: Vec<f64> = (0..8).map(|i| 2.0 * (0.2 * i as f64).exp()).collect();
+        let balls = node_balls(&tree, &radii);
+        assert_eq!(balls[root], None);
+        for &k in &leaves {
+            let n = &tree.nodes[k];
+            let (a, z) = (radii[n.start as usize], radii[n.end as usize - 1]);
+            let b = balls[k].unwrap();
+            assert!(a <= b && b <= z, "leaf {k}: {b} not in [{a}, {z}]");
+            assert!((b - (a * z).sqrt()).abs() < 1e-12 * b);
+        }
+        // One point without a radius: its leaf and every node above it are split; none with
+        // one: NaN.
+        let mut radii = vec![3.0; 8];
+        radii[5] = f64::NAN;
+        let balls = node_balls(&tree, &radii);
+        assert_eq!(balls[root], None);
+        let holder = leaves
+            .iter()
+            .find(|&&k| (tree.nodes[k].start..tree.nodes[k].end).contains(&5))
+            .unwrap();
+        assert_eq!(balls[*holder], None);
+        assert!(
+            leaves
+                .iter()
+                .filter(|&&k| k != *holder)
+                .all(|&k| balls[k].is_some_and(|b| (b - 3.0).abs() < 1e-12))
+        );
+        let balls = node_balls(&tree, &[f64::NAN; 8]);
+        assert!(balls.iter().all(|b| b.is_some_and(f64::is_nan)));
+        // Radii a factor 2 apart still stand as one, a hair more do not.
+        let radii: Vec<f64> = (0..8).map(|i| if i < 4 { 1.0 } else { 2.0 }).collect();
+        assert!(node_balls(&tree, &radii)[root].is_some());
+        let radii: Vec<f64> = (0..8).map(|i| if i < 4 { 1.0 } else { 2.01 }).collect();
+        assert_eq!(node_balls(&tree, &radii)[root], None);
+    }
+
+    #[test]
+    fn a_pairs_ball_is_the_geometric_mean_and_nan_without_one() {
+        assert!((pair_ball(2.0, 8.0) - 4.0).abs() < 1e-15);
+        assert!(pair_ball(f64::NAN, 8.0).is_nan());
+        assert!(pair_ball(3.0, f64::NAN).is_nan());
+    }
 }

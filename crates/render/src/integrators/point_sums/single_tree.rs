@@ -12,11 +12,15 @@
 //! Mitsuba's `irrtree`): a distant leaf is one evaluation, not `leaf` evaluations.
 //!
 //! Radial models only (a node's flux is summed without incident directions): the directional
-//! dipole is refused with an error naming the material.
+//! dipole and drifting materials are refused with an error naming the material. A material
+//! that gives each point its own ball (`sphere_radius = "local"`, [`crate::local_radius`]) is
+//! summed with each pair's ball: a node stands for its samples only where their radii spread
+//! by at most [`super::BALL_SPREAD`] (its ball their geometric mean), and a leaf sums each pair
+//! with its own, so at ε → 0 the traversal still equals `exact`.
 
 use super::{
-    Counts, accepts, add_samples, eps_sweep, illumination_tree_bytes, illumination_trees, inside,
-    rd_times,
+    Counts, TreeBalls, accepts, add_samples, ball_outputs, eps_sweep, illumination_tree_bytes,
+    illumination_trees, inside, pair_ball, rd_times, tree_balls,
 };
 use crate::Error;
 use crate::frame::Frame;
@@ -26,9 +30,10 @@ use crate::integrators::options::{
 };
 use crate::integrators::{
     Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep, add_scaled, add_weighted,
-    check_radial,
+    check_radial_balls,
 };
 use crate::irradiance::IrradianceSettings;
+use crate::local_radius::frame_balls;
 use crate::progress::Progress;
 use crate::shading::TranslucentShading;
 use glam::DVec3;
@@ -82,13 +87,16 @@ impl SingleTree {
     }
 }
 
-/// The sum at `x` over the tree, by Algorithm 1 (before the exit weight).
+/// The sum at `x` over the tree, by Algorithm 1 (before the exit weight). With `balls` (the
+/// tree's [`TreeBalls`] and x's radius in mm), each pair takes its own ball: a node is accepted
+/// only where one radius stands for its samples, and a leaf sums each pair with its own.
 pub(crate) fn single(
     tree: &IrradianceTree,
     x: DVec3,
     eps: f64,
     sh: &TranslucentShading,
     counts: &Counts,
+    balls: Option<(&TreeBalls<'_>, f64)>,
 ) -> Rgb {
     let mut acc = [0.0; 3];
     if tree.tree.nodes.is_empty() {
@@ -102,14 +110,27 @@ pub(crate) fn single(
         let node = &tree.tree.nodes[k as usize];
         let cl = &tree.clusters[k as usize];
         let d2 = (cl.position - x).length_squared();
-        if accepts(cl.area, d2, eps) && !inside(node, x) {
-            let rd = sh.rd_sample_scene(d2.sqrt(), cl.area);
+        // The node's one ball, if its samples share one (always, with one profile).
+        let ball = match balls {
+            Some((b, rx)) => b.nodes[k as usize].map(|r| Some(pair_ball(r, rx))),
+            None => Some(None),
+        };
+        if let Some(ball) = ball
+            && accepts(cl.area, d2, eps)
+            && !inside(node, x)
+        {
+            let rd = match (ball, balls) {
+                (Some(pair), Some((b, _))) => sh.rd_sample_ball(d2.sqrt(), cl.area, b.family, pair),
+                _ => sh.rd_sample_scene(d2.sqrt(), cl.area),
+            };
             add_scaled(&mut acc, rd_times(rd, cl.flux), 1.0);
             clusters += 1;
         } else if node.is_leaf() {
-            let points = tree.points_of(node);
-            add_samples(&mut acc, points, x, sh);
-            singles += points.len() as u64;
+            match balls {
+                Some((b, rx)) => b.add_samples(&mut acc, tree, node, x, rx, sh),
+                None => add_samples(&mut acc, tree.points_of(node), x, sh),
+            }
+            singles += node.len() as u64;
         } else {
             // Right first, so the left subtree is summed first.
             stack.push(node.right);
@@ -141,20 +162,26 @@ impl Integrator for SingleTree {
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
-        check_radial(frame, METHOD.name)?;
+        check_radial_balls(frame, METHOD.name)?;
         let samples = frame.irradiance_samples(&self.irradiance);
+        let balls = frame_balls(frame, &frame.samples_by_object(&samples))?;
         let trees = frame.timed("illumination_tree", || illumination_trees(frame, &samples));
+        let tree_balls = tree_balls(&balls, &trees);
         let counts = Counts::default();
         let values: Vec<Rgb> = frame.timed("shading", || {
             frame
                 .gbuffer
                 .samples
                 .par_iter()
-                .map(|g| {
+                .enumerate()
+                .map(|(k, g)| {
                     progress.advance(1);
                     match (frame.shading_of(g.object), &trees[g.object as usize]) {
                         (Some(sh), Some(t)) => {
-                            let sum = single(t, g.p, self.eps, sh, &counts);
+                            let own = tree_balls[g.object as usize]
+                                .as_ref()
+                                .map(|b| (b, balls.points.get(k).copied().unwrap_or(f64::NAN)));
+                            let sum = single(t, g.p, self.eps, sh, &counts, own);
                             let mut out = [0.0; 3];
                             add_weighted(&mut out, sum, sh.exit_weights(g.n, g.wo));
                             out
@@ -164,9 +191,13 @@ impl Integrator for SingleTree {
                 })
                 .collect()
         });
+        let mut stats = counts.stats("nodes_visited");
+        let mut layers = Vec::new();
+        ball_outputs(frame, &balls, &mut stats, &mut layers);
         Ok(Shaded {
             values,
-            stats: counts.stats("nodes_visited"),
+            stats,
+            layers,
             ..Shaded::default()
         })
     }
