@@ -210,7 +210,8 @@ pub(crate) fn node_balls<const D: usize>(tree: &KdTree<D>, radii: &[f64]) -> Vec
             } else if s.none > 0 || !(s.hi - s.lo <= BALL_SPREAD) {
                 None
             } else {
-                Some((s.sum_ln / f64::from(s.n - s.none)).exp())
+                // Every point has a radius here (s.none == 0).
+                Some((s.sum_ln / f64::from(s.n)).exp())
             }
         })
         .collect()
@@ -521,8 +522,12 @@ mod tests {
                 .filter(|&&k| k != *holder)
                 .all(|&k| balls[k].is_some_and(|b| (b - 3.0).abs() < 1e-12))
         );
-        let balls = node_balls(&tree, &[f64::NAN; 8]);
-        assert!(balls.iter().all(|b| b.is_some_and(f64::is_nan)));
+        // No radius (NaN), and radii that are none (0, negative, infinite): every node takes
+        // the half-space's profile.
+        for none in [f64::NAN, 0.0, -1.0, f64::INFINITY] {
+            let balls = node_balls(&tree, &[none; 8]);
+            assert!(balls.iter().all(|b| b.is_some_and(f64::is_nan)), "{none}");
+        }
         // Radii a factor 2 apart still stand as one, a hair more do not.
         let radii: Vec<f64> = (0..8).map(|i| if i < 4 { 1.0 } else { 2.0 }).collect();
         assert!(node_balls(&tree, &radii)[root].is_some());
