@@ -30,6 +30,17 @@ struct CachedSamples {
     samples: Arc<Vec<ObjectSamples>>,
 }
 
+/// Samples lit also by the light the surfaces trade, for one setting, with the gather's
+/// figures (name, value).
+struct CachedBounces {
+    settings: IrradianceSettings,
+    samples: Arc<Vec<ObjectSamples>>,
+    figures: Vec<(&'static str, f64)>,
+}
+
+/// What [`Frame::bounced_samples`] keeps: the samples and the gather's figures (name, value).
+pub type Bounced = (Arc<Vec<ObjectSamples>>, Vec<(&'static str, f64)>);
+
 /// The parts of a render every integrator shares. Built by [`Frame::prepare`]; integrators
 /// read it (and may ask for irradiance samples) through a shared reference.
 pub struct Frame<'a> {
@@ -47,6 +58,7 @@ pub struct Frame<'a> {
     pub shading: Vec<Option<TranslucentShading>>,
     stages: Mutex<Vec<Stage>>,
     samples: Mutex<Option<CachedSamples>>,
+    bounced: Mutex<Option<CachedBounces>>,
     warnings: Mutex<Vec<String>>,
 }
 
@@ -80,6 +92,7 @@ impl<'a> Frame<'a> {
             shading,
             stages: Mutex::new(stages),
             samples: Mutex::new(None),
+            bounced: Mutex::new(None),
             warnings: Mutex::new(warnings),
         }
     }
@@ -174,6 +187,31 @@ impl Frame<'_> {
             samples: Arc::clone(&samples),
         });
         samples
+    }
+
+    /// The irradiance samples lit also by the light the surfaces trade for `settings`
+    /// (`settings.bounces` > 0), built by `make` on the first request and shared by later
+    /// requests with the same settings (the point sums build them:
+    /// `crate::integrators::point_sums::lit_samples`), with the figures `make` returned.
+    pub fn bounced_samples<E>(
+        &self,
+        settings: &IrradianceSettings,
+        make: impl FnOnce() -> Result<(Vec<ObjectSamples>, Vec<(&'static str, f64)>), E>,
+    ) -> Result<Bounced, E> {
+        let mut cache = self.bounced.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(c) = cache.as_ref()
+            && c.settings == *settings
+        {
+            return Ok((Arc::clone(&c.samples), c.figures.clone()));
+        }
+        let (samples, figures) = make()?;
+        let samples = Arc::new(samples);
+        *cache = Some(CachedBounces {
+            settings: *settings,
+            samples: Arc::clone(&samples),
+            figures: figures.clone(),
+        });
+        Ok((samples, figures))
     }
 
     /// Per visible translucent object (in [`Frame::visible`]'s order), the G-buffer samples on

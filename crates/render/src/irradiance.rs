@@ -36,10 +36,14 @@ pub struct IrradianceSettings {
     pub max_samples: usize,
     /// Light samples per quad or environment light at each irradiance sample.
     pub light_samples: u32,
+    /// Bounces of the light the surfaces trade, added to the direct light by the point sums
+    /// (`crate::integrators::point_sums::lit_samples`; 0: direct light only). [`compute`]
+    /// lights the samples directly whatever this says.
+    pub bounces: u32,
 }
 
 impl Default for IrradianceSettings {
-    /// The declared defaults of `--spacing` and `--max-samples`
+    /// The declared defaults of `--spacing`, `--max-samples` and `--bounces`
     /// ([`crate::integrators::options::SAMPLE_OPTIONS`]), 16 light samples.
     fn default() -> Self {
         use crate::integrators::options::{SAMPLE_OPTIONS, declared};
@@ -47,6 +51,7 @@ impl Default for IrradianceSettings {
             spacing_mfp: declared(&SAMPLE_OPTIONS, "spacing"),
             max_samples: declared(&SAMPLE_OPTIONS, "max-samples"),
             light_samples: 16,
+            bounces: declared(&SAMPLE_OPTIONS, "bounces"),
         }
     }
 }

@@ -28,6 +28,9 @@ pub enum Stream {
     IrradiancePoints = 8,
     /// Paths of the volumetric path tracer (per pixel sample).
     Volume = 9,
+    /// Rays gathering the light the surfaces trade into the irradiance samples (per sample
+    /// and bounce).
+    Interreflection = 10,
 }
 
 /// The generator for work item `index` of `stream` under `seed`.

@@ -188,8 +188,21 @@ pub const MAX_SAMPLES: OptionSpec = OptionSpec {
     values: &[],
 };
 
-/// The irradiance-sample options every point sum takes first: [`SPACING`], [`MAX_SAMPLES`].
-pub const SAMPLE_OPTIONS: [OptionSpec; 2] = [SPACING, MAX_SAMPLES];
+/// `--bounces N`: bounces of the light the surfaces trade, gathered into the irradiance
+/// samples (the point sums; [`crate::integrators::point_sums::interreflection`]).
+pub const BOUNCES: OptionSpec = OptionSpec {
+    name: "bounces",
+    value_name: "N",
+    default: "0",
+    help: "Bounces of the light the surfaces trade (interreflection), gathered into the \
+           irradiance samples (0: direct light only)",
+    kind: OptionKind::Value,
+    values: &[],
+};
+
+/// The irradiance-sample options every point sum takes first: [`SPACING`], [`MAX_SAMPLES`],
+/// [`BOUNCES`].
+pub const SAMPLE_OPTIONS: [OptionSpec; 3] = [SPACING, MAX_SAMPLES, BOUNCES];
 
 /// `--solid-angle E` of the tree traversals (`single-tree`, `dual-tree`, `dual-tree-fmm`):
 /// the solid-angle threshold ε of Jensen & Buhler 2002 and Milaenen et al. 2019.
@@ -351,9 +364,17 @@ pub fn sample_settings(o: &MethodOptions) -> Result<IrradianceSettings, Error> {
             "--spacing must be positive, got {spacing}"
         )));
     }
+    let bounces: u32 = o.get(&SAMPLE_OPTIONS, "bounces")?;
+    let most = crate::integrators::point_sums::interreflection::MAX_BOUNCES;
+    if bounces > most {
+        return Err(Error::Input(format!(
+            "--bounces must be at most {most}, got {bounces}"
+        )));
+    }
     Ok(IrradianceSettings {
         spacing_mfp: spacing,
         max_samples: o.get(&SAMPLE_OPTIONS, "max-samples")?,
+        bounces,
         ..IrradianceSettings::default()
     })
 }

@@ -26,6 +26,10 @@
 //! - Scattering orders: `--scattering single` or `multiple` keeps only the light whose path
 //!   collided once, or two times or more, in the media ([`Scattering`]), so the share of each
 //!   order in real transport can be measured (`cargo xtask compare --deficit`).
+//! - Light traded between translucent surfaces: `--reentry no` ends a path where, having left
+//!   a medium, it meets a translucent surface, so the image holds only the light a BSSRDF
+//!   under direct light can carry; the difference from `yes` is the interreflection between
+//!   the objects' parts (concave folds, facing surfaces).
 //! - The rest of the scene (diffuse surfaces, their shadows, the background) is lit as for
 //!   every method, by `render`'s direct light, so whole images compare.
 //!
@@ -52,7 +56,7 @@ use sss_bssrdf::Rgb;
 use sss_scene::{Light, Scene};
 
 /// The options of `volpath`.
-pub const OPTIONS: [OptionSpec; 5] = [
+pub const OPTIONS: [OptionSpec; 6] = [
     OptionSpec {
         name: "spp",
         value_name: "N",
@@ -99,6 +103,17 @@ pub const OPTIONS: [OptionSpec; 5] = [
                crossed a medium without a collision is only in `all`",
         kind: OptionKind::Value,
         values: &["all", "single", "multiple"],
+    },
+    OptionSpec {
+        name: "reentry",
+        value_name: "YES|NO",
+        default: "yes",
+        help: "Whether light that left a translucent surface and met one again counts (`no`: \
+               a path ends where, leaving a medium, it meets a translucent surface, so the \
+               image holds no light traded between the objects' parts, as a BSSRDF under \
+               direct light)",
+        kind: OptionKind::Value,
+        values: &["yes", "no"],
     },
 ];
 
@@ -158,6 +173,9 @@ pub struct VolPath {
     pub max_events: Option<u64>,
     /// Which scattering orders the image holds.
     pub scattering: Scattering,
+    /// Whether light that left a translucent surface and met one again counts
+    /// (interreflection between translucent surfaces).
+    pub reentry: bool,
 }
 
 impl Default for VolPath {
@@ -207,12 +225,22 @@ impl VolPath {
                 )));
             }
         };
+        let reentry = match o.get::<String>(&OPTIONS, "reentry")?.as_str() {
+            "yes" => true,
+            "no" => false,
+            other => {
+                return Err(Error::Input(format!(
+                    "--reentry: `{other}` is not one of yes, no"
+                )));
+            }
+        };
         Ok(VolPath {
             spp,
             boundary,
             g,
             max_events,
             scattering,
+            reentry,
         })
     }
 
@@ -246,14 +274,16 @@ impl Integrator for VolPath {
 
     fn describe(&self) -> String {
         format!(
-            "paths per pixel sample: {}, boundary {}, g {}, max events {}, scattering {}",
+            "paths per pixel sample: {}, boundary {}, g {}, max events {}, scattering {}, \
+             reentry {}",
             self.spp,
             self.boundary.name(),
             self.g
                 .map_or("of the material".to_string(), |g| g.to_string()),
             self.max_events
                 .map_or("none".to_string(), |n| n.to_string()),
-            self.scattering.name()
+            self.scattering.name(),
+            if self.reentry { "yes" } else { "no" }
         )
     }
 
@@ -271,6 +301,7 @@ impl Integrator for VolPath {
             boundary: self.boundary,
             max_events: self.max_events,
             scattering: self.scattering,
+            reentry: self.reentry,
         };
         let spp = self.spp.max(1);
         let gspp = frame.gbuffer.samples_per_pixel as u64;

@@ -117,6 +117,9 @@ pub struct Walker<'a> {
     pub max_events: Option<u64>,
     /// Which scattering orders the estimate keeps.
     pub scattering: Scattering,
+    /// Whether a path that left a medium goes on into a translucent surface it meets (false:
+    /// it ends there, so no light traded between translucent surfaces counts).
+    pub reentry: bool,
 }
 
 /// Where the path is.
@@ -322,7 +325,7 @@ impl Walker<'_> {
                     let Some(med) = self.interior_of(hit.object) else {
                         return acc;
                     };
-                    if self.boundary == Boundary::Lambertian {
+                    if self.boundary == Boundary::Lambertian || !self.reentry {
                         return acc;
                     }
                     events += 1;

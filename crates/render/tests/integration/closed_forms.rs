@@ -223,6 +223,7 @@ fn slab(units_per_mm: f64) -> ([f64; 3], [f64; 3]) {
             spacing_mfp: 0.35,
             max_samples: 1_000_000,
             light_samples: 1,
+            bounces: 0,
         },
     };
     let out = render(&scene, &exact, &RenderSettings::default(), &NoProgress).unwrap();

@@ -14,6 +14,7 @@ mod exr_budget;
 mod flip_evaluator;
 mod fuzz_regressions;
 mod integrator_contract;
+mod interreflection;
 mod local_radius;
 mod manylight;
 mod metrics_by_hand;

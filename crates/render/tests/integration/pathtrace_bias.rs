@@ -107,6 +107,7 @@ fn exact_reference(sc: &Scene) -> RenderOutput {
             spacing_mfp: 0.25,
             max_samples: 400_000,
             light_samples: 1,
+            bounces: 0,
         },
     };
     render(sc, &ex, &RenderSettings::default(), &NoProgress).unwrap()

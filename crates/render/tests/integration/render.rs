@@ -47,6 +47,7 @@ fn flat_slab_matches_closed_form() {
             spacing_mfp: 0.25,
             max_samples: 1_000_000,
             light_samples: 1,
+            bounces: 0,
         },
     };
     let out = render(&scene, &exact, &RenderSettings::default(), &NoProgress).unwrap();
@@ -109,6 +110,7 @@ fn pathtrace_agrees_with_exact_on_a_sphere() {
                 spacing_mfp: 0.25,
                 max_samples: 400_000,
                 light_samples: 1,
+                bounces: 0,
             },
         },
         &RenderSettings::default(),
@@ -222,6 +224,7 @@ fn irradiance_samples_cover_the_object() {
         spacing_mfp: 0.5,
         max_samples: 50_000,
         light_samples: 1,
+        bounces: 0,
     };
     let samples = irradiance::compute(&scene, &geom, &[0], &settings, 1);
     assert_eq!(samples.len(), 1);
@@ -384,6 +387,7 @@ fn irradiance_samples_only_within_reach_of_what_is_seen() {
         spacing_mfp: 2.0,
         max_samples: 200_000,
         light_samples: 1,
+        bounces: 0,
     };
     let frame = Frame::prepare(&scene, 1);
     let sh = frame.shading_of(0).unwrap();

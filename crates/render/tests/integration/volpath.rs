@@ -4,9 +4,11 @@
 
 use crate::common::{scene_of, uv_sphere};
 use glam::DVec3;
+use sss_bssrdf::Rgb;
 use sss_bssrdf::fresnel::ft_dielectric;
 use sss_bssrdf::{Medium, ModelKind};
 use sss_render::frame::Frame;
+use sss_render::gbuffer::GSample;
 use sss_render::integrators::{self, Integrator, MethodOptions};
 use sss_render::progress::NoProgress;
 use sss_render::scene::{Camera, Light, Material, MaterialKind, Scene, Translucent};
@@ -51,6 +53,23 @@ fn furnace(material: Material) -> Scene {
     )
 }
 
+/// The camera samples of `frame` whose shading normal faces the camera, each with its value
+/// and its Fresnel transmittance 1 − F(1.3, cos θ_o), what a white furnace returns there. (A
+/// shading normal facing away, at the silhouette, makes the camera ray arrive from inside by
+/// Mitsuba's convention, which we keep: those are left out.)
+fn facing<'f>(
+    frame: &'f Frame<'_>,
+    values: &'f [Rgb],
+) -> impl Iterator<Item = (&'f GSample, Rgb, f64)> + 'f {
+    frame
+        .gbuffer
+        .samples
+        .iter()
+        .zip(values)
+        .filter(|(g, _)| g.n.dot(g.wo) > 0.0)
+        .map(|(g, v)| (g, *v, ft_dielectric(g.n.dot(g.wo), 1.3)))
+}
+
 fn volpath(options: MethodOptions) -> Box<dyn Integrator> {
     integrators::build("volpath", &options).unwrap()
 }
@@ -66,14 +85,7 @@ fn a_white_furnace_returns_every_photon_through_the_dielectric() {
     let m = volpath(MethodOptions::new().with("spp", 8));
     let shaded = m.integrate(&frame, &NoProgress).unwrap();
     let mut checked = 0;
-    for (g, v) in frame.gbuffer.samples.iter().zip(&shaded.values) {
-        // A shading normal facing away from the camera (at the silhouette) makes the camera
-        // ray arrive from inside by Mitsuba's convention, which we keep: skipped here.
-        let cos = g.n.dot(g.wo);
-        if cos <= 0.0 {
-            continue;
-        }
-        let want = ft_dielectric(cos, 1.3);
+    for (g, v, want) in facing(&frame, &shaded.values) {
         for c in 0..3 {
             assert!(
                 (v[c] - want).abs() < 1e-9,
@@ -150,6 +162,50 @@ fn a_white_furnace_with_the_lambertian_boundary_returns_the_environment() {
     }
 }
 
+/// `--reentry no` ends a path where, having left a medium, it meets a translucent surface. On
+/// one convex sphere no path can meet it again from outside, so the white furnace still
+/// returns exactly 1 − F(η, cos θ_o) at every camera sample (no path ends on the surface it
+/// just left). Beside a second sphere, every path still returns 1 − F or 0 (nothing is
+/// absorbed), the image is darker, and each sphere loses about its view factor to the other:
+/// by reciprocity A₁F₁₂ = A₂F₂₁, the small sphere (radius 0.6) about (1/0.6)² = 2.8 times the
+/// big one's fraction (the spheres' exitance is near uniform and leaves both alike).
+#[test]
+fn without_reentry_a_convex_sphere_keeps_every_photon_and_two_lose_their_view_factors() {
+    let no = || volpath(MethodOptions::new().with("spp", 16).with("reentry", "no"));
+    let mut one = furnace(white([2.0; 3]));
+    one.objects.truncate(1);
+    let frame = Frame::prepare(&one, 1);
+    let shaded = no().integrate(&frame, &NoProgress).unwrap();
+    let mut checked = 0;
+    for (g, v, want) in facing(&frame, &shaded.values) {
+        assert!((v[0] - want).abs() < 1e-9, "{v:?} against {want} at {g:?}");
+        checked += 1;
+    }
+    assert!(checked > 100);
+
+    let two = furnace(white([2.0; 3]));
+    let frame = Frame::prepare(&two, 1);
+    let shaded = no().integrate(&frame, &NoProgress).unwrap();
+    // Per sphere: Σ value and Σ (1 − F) over its camera samples facing the camera.
+    let (mut got, mut full) = ([0.0; 2], [0.0; 2]);
+    for (g, v, want) in facing(&frame, &shaded.values) {
+        assert!(v[0] <= want + 1e-9, "{v:?} above {want}");
+        got[g.object as usize] += v[0];
+        full[g.object as usize] += want;
+    }
+    let lost = [1.0 - got[0] / full[0], 1.0 - got[1] / full[1]];
+    eprintln!(
+        "lost without reentry: big sphere {:.4}, small {:.4}",
+        lost[0], lost[1]
+    );
+    assert!(lost[0] > 0.005 && lost[1] > 0.005, "{lost:?}");
+    let ratio = lost[1] / lost[0];
+    assert!(
+        (ratio - (1.0f64 / 0.6).powi(2)).abs() < 0.3 * (1.0f64 / 0.6).powi(2),
+        "small over big {ratio}"
+    );
+}
+
 /// A point or directional light cannot be reached through a smooth dielectric: the render is
 /// refused with an error naming the light and the Lambertian boundary, which renders it.
 #[test]
@@ -201,6 +257,7 @@ fn bad_options_are_one_line_errors() {
         ("max-events", "0", "at least 1"),
         ("max-events", "-3", "neither `none` nor a whole number"),
         ("scattering", "double", "all, single, multiple"),
+        ("reentry", "maybe", "yes, no"),
     ] {
         let e = integrators::build("volpath", &MethodOptions::new().with(k, v))
             .err()

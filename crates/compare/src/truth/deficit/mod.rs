@@ -1,14 +1,16 @@
 //! `cargo xtask compare --deficit`: where a BSSRDF model's error against real light transport
 //! comes from, measured on controlled set-ups.
 //!
-//! Every row renders one set-up ([`setups`]) four times and takes image means over the
-//! scored pixels ([`measure`]): `volpath` (the truth: light transport in the medium itself,
-//! checked against Mitsuba 3 and MCML), `volpath --scattering single` (the truth's single
-//! scattering alone), `mc-table` under `pathtrace` (the model's integral, which discretises
-//! nothing) and the same with `angular = "albedo"` (the half-space's directional albedo for
-//! its angular factors, `sss_bssrdf::DirectionalAlbedo`). Each is rendered until the relative standard error of its mean is about the
-//! target. The model over the truth, per channel, is the row's figure; the sweeps separate
-//! the effects the planar, normal-incidence, separable model leaves out:
+//! Every row renders one set-up ([`setups`]) four times (five on the meshes) and takes image
+//! means over the scored pixels ([`measure`]): `volpath` (the truth: light transport in the
+//! medium itself, checked against Mitsuba 3 and MCML), `volpath --scattering single` (the
+//! truth's single scattering alone), on the meshes `volpath --reentry no` (the truth without
+//! the light their parts trade, which a BSSRDF under direct light cannot carry), `mc-table`
+//! under `pathtrace` (the model's integral, which discretises nothing) and the same with
+//! `angular = "albedo"` (the half-space's directional albedo for its angular factors,
+//! `sss_bssrdf::DirectionalAlbedo`). Each is rendered until the relative standard error of
+//! its mean is about the target. The model over the truth, per channel, is the row's figure;
+//! the sweeps separate the effects the planar, normal-incidence, separable model leaves out:
 //!
 //! - `incidence`: a half-space lit by a small sun (±10°) at an angle, seen head-on;
 //! - `exit-sun`, `exit-environment`: the half-space lit head-on or by a uniform environment,
@@ -17,15 +19,17 @@
 //!   or from the front (thin parts);
 //! - `sphere-environment`, `sphere-quad`: the 10 mm sphere of `--truth` scaled to radii of
 //!   2–160 mm (curvature, against the mean free path);
-//! - `bunny-quad`, `dragon-quad`: the truth's bunny and dragon scaled 1, 4 and 16 times.
+//! - `bunny-quad`, `dragon-quad`: the truth's bunny and dragon scaled 1, 4, 16 and 64 times.
 //!
-//! The report apportions each scaled scene's deficit into three factors whose product is the
-//! model's image mean over the truth's: the size (scale 1 against the largest scale, where
-//! the surface is flat over a mean free path: curvature and thin parts), the angles (the
-//! largest scale against the half-space lit and seen head-on: the incidence and exit
-//! directions of that scene's light and view, single scattering's lobe among them) and the
-//! profile with its boundary terms (the half-space head-on, what is left when geometry and
-//! angles match the table's own set-up). `--quick` runs a few rows at low precision.
+//! The report apportions each scaled scene's deficit into four factors whose product is the
+//! model's image mean over the truth's: interreflection (the truth without the light the
+//! object's parts trade, over the truth; 1 on the convex set-ups, which trade none), and,
+//! against the truth without it, the size (scale 1 against the largest scale, where the
+//! surface is flat over a mean free path: curvature and thin parts), the angles (the largest
+//! scale against the half-space lit and seen head-on: the incidence and exit directions of
+//! that scene's light and view, single scattering's lobe among them) and the profile with
+//! its boundary terms (the half-space head-on, what is left when geometry and angles match
+//! the table's own set-up). `--quick` runs a few rows at low precision.
 //!
 //! Writes `deficit.csv` (columns in `docs/compare.md`), `deficit_<group>.png`/`.svg` (the
 //! ratio against the swept quantity, per channel) and `deficit/<row>.toml`, each flat set-up's
@@ -156,6 +160,29 @@ impl Experiment for DeficitExperiment {
                 })
             };
             let (truth, _) = measure(&scene, &all, plan.volpath_spp, plan.target, cfg.seed)?;
+            // The truth without the light traded between the object's parts, where it has
+            // parts that see each other.
+            let direct = if setup.trades_light() {
+                let without = |spp: u32| -> Box<dyn Integrator> {
+                    Box::new(VolPath {
+                        spp,
+                        reentry: false,
+                        ..VolPath::default()
+                    })
+                };
+                Some(
+                    measure(
+                        &scene,
+                        &without,
+                        plan.volpath_spp,
+                        plan.target,
+                        cfg.seed + 3,
+                    )?
+                    .0,
+                )
+            } else {
+                None
+            };
             let (single, _) =
                 measure(&scene, &single, plan.volpath_spp, plan.target, cfg.seed + 2)?;
             let (model, pixels) = measure(
@@ -179,6 +206,7 @@ impl Experiment for DeficitExperiment {
                 setup: setup.clone(),
                 truth,
                 single,
+                direct,
                 model,
                 albedo,
                 pixels: pixels.len(),

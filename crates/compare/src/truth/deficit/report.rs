@@ -15,6 +15,9 @@ pub(crate) struct DeficitRow {
     pub truth: Mean,
     /// `volpath`, single scattering alone.
     pub single: Mean,
+    /// `volpath --reentry no`: the truth without the light the object's parts trade; None on
+    /// the convex set-ups, which trade none ([`Setup::trades_light`]).
+    pub direct: Option<Mean>,
     /// The model under `pathtrace`.
     pub model: Mean,
     /// The model with `angular = "albedo"` under `pathtrace`.
@@ -38,10 +41,30 @@ impl DeficitRow {
     pub fn single_share(&self) -> [Option<(f64, f64)>; 3] {
         ratio(&self.single, &self.truth)
     }
+
+    /// The truth without the light the object's parts trade, over the truth, per channel
+    /// (None where not measured: a convex set-up, where it is 1).
+    pub fn direct_share(&self) -> [Option<(f64, f64)>; 3] {
+        match &self.direct {
+            Some(d) => ratio(d, &self.truth),
+            None => [None; 3],
+        }
+    }
+
+    /// The model's image mean over the truth's without the light the object's parts trade
+    /// (over the truth itself on a convex set-up, where the two are the same).
+    pub fn direct_ratio(&self) -> [Option<(f64, f64)>; 3] {
+        ratio(&self.model, self.direct.as_ref().unwrap_or(&self.truth))
+    }
+
+    /// [`Self::direct_ratio`] for the model with `angular = "albedo"`.
+    pub fn albedo_direct_ratio(&self) -> [Option<(f64, f64)>; 3] {
+        ratio(&self.albedo, self.direct.as_ref().unwrap_or(&self.truth))
+    }
 }
 
 /// The columns of `deficit.csv`.
-pub const COLUMNS: [&str; 34] = [
+pub const COLUMNS: [&str; 37] = [
     "group",
     "medium",
     "param",
@@ -71,6 +94,9 @@ pub const COLUMNS: [&str; 34] = [
     "single_r",
     "single_g",
     "single_b",
+    "direct_r",
+    "direct_g",
+    "direct_b",
     "truth_spp",
     "model_spp",
     "truth_seconds",
@@ -100,6 +126,7 @@ pub(crate) fn deficit_csv(rows: &[DeficitRow]) -> Csv {
         f.extend(a.iter().map(|v| csv_num(v.map(|x| x.0))));
         f.extend(a.iter().map(|v| csv_num(v.map(|x| x.1))));
         f.extend(s.iter().map(|v| csv_num(v.map(|x| x.0))));
+        f.extend(r.direct_share().iter().map(|v| csv_num(v.map(|x| x.0))));
         f.push(r.truth.spp.to_string());
         f.push(r.model.spp.to_string());
         f.push(csv_num(Some(r.truth.seconds)));
@@ -132,23 +159,30 @@ fn rgb3(v: [Option<(f64, f64)>; 3], plus_minus: bool) -> String {
         .join(" / ")
 }
 
-/// A scaled scene's deficit as three factors per channel, whose product is its model/truth
-/// at scale 1: size (scale 1 over the flat limit), angles (the flat limit over the
-/// half-space head-on) and profile (the half-space head-on).
+/// A scaled scene's deficit as four factors per channel, whose product is its model/truth
+/// at scale 1: interreflection (at scale 1, the truth without the light the object's parts
+/// trade over the truth) and, against that truth without it, size (scale 1 over the flat
+/// limit), angles (the flat limit over the half-space head-on) and profile (the half-space
+/// head-on).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Apportioned {
     pub group: &'static str,
     pub medium: &'static str,
     /// The two largest scales measured.
     pub scales: (f64, f64),
-    /// Model / truth at scale 1, at the largest scale, and in the flat limit.
+    /// Model / truth at scale 1; model over the truth without traded light at the largest
+    /// scale and in the flat limit.
     pub total: Rgb,
     pub largest: Rgb,
     pub flat: Rgb,
     pub size: Rgb,
     pub angles: Rgb,
     pub profile: Rgb,
-    /// With `angular = "albedo"`: model / truth at scale 1 and in the flat limit.
+    /// The truth without the light the object's parts trade over the truth, at scale 1 (1
+    /// where it was not measured).
+    pub interreflection: Rgb,
+    /// With `angular = "albedo"`: model / truth at scale 1, and over the truth without
+    /// traded light in the flat limit.
     pub albedo_total: Rgb,
     pub albedo_flat: Rgb,
 }
@@ -184,7 +218,9 @@ pub(crate) fn apportion(rows: &[DeficitRow]) -> Vec<Apportioned> {
         _ => 0.0,
     };
     let ratio_of = |r: &DeficitRow| values(r.ratio());
-    let albedo_of = |r: &DeficitRow| values(r.albedo_ratio());
+    let direct_of = |r: &DeficitRow| values(r.direct_ratio());
+    let albedo_of = |r: &DeficitRow| values(r.albedo_direct_ratio());
+    let traded_of = |r: &DeficitRow| values(r.direct_share()).unwrap_or([1.0; 3]);
     let mut out = Vec::new();
     for (g, m) in groups_of(rows) {
         let Some(head_on) = row_at(rows, "incidence", m, 0.0) else {
@@ -202,15 +238,18 @@ pub(crate) fn apportion(rows: &[DeficitRow]) -> Vec<Apportioned> {
         let [.., r1, r2] = larger.as_slice() else {
             continue;
         };
-        let (Some(t), Some(d1), Some(d2), Some(n)) = (
+        let (Some(t), Some(u), Some(d1), Some(d2), Some(n)) = (
             ratio_of(unit),
-            ratio_of(r1),
-            ratio_of(r2),
+            direct_of(unit),
+            direct_of(r1),
+            direct_of(r2),
             ratio_of(head_on),
         ) else {
             continue;
         };
-        let (Some(at), Some(a1), Some(a2)) = (albedo_of(unit), albedo_of(r1), albedo_of(r2)) else {
+        let (Some(at), Some(a1), Some(a2)) =
+            (values(unit.albedo_ratio()), albedo_of(r1), albedo_of(r2))
+        else {
             continue;
         };
         let (s1, s2) = (scale_of(r1), scale_of(r2));
@@ -226,9 +265,10 @@ pub(crate) fn apportion(rows: &[DeficitRow]) -> Vec<Apportioned> {
             total: t,
             largest: d2,
             flat,
-            size: div(t, flat),
+            size: div(u, flat),
             angles: div(flat, n),
             profile: n,
+            interreflection: traded_of(unit),
             albedo_total: at,
             albedo_flat,
         });
@@ -236,16 +276,22 @@ pub(crate) fn apportion(rows: &[DeficitRow]) -> Vec<Apportioned> {
     out
 }
 
-/// Each factor's share of the deficit, per channel: ln(factor)/ln(total) (the logarithms add
-/// up), None where the total is within 0.5 % of 1.
-pub(crate) fn shares(a: &Apportioned) -> [[Option<f64>; 3]; 3] {
+/// Each factor's share of the deficit, per channel, in the order size, angles, profile,
+/// interreflection: ln(factor)/ln(total) (the logarithms add up), None where the total is
+/// within 0.5 % of 1.
+pub(crate) fn shares(a: &Apportioned) -> [[Option<f64>; 3]; 4] {
     let share = |f: Rgb| -> [Option<f64>; 3] {
         std::array::from_fn(|c| {
             let t = a.total[c];
             ((t - 1.0).abs() > 0.005 && t > 0.0 && f[c] > 0.0).then(|| f[c].ln() / t.ln())
         })
     };
-    [share(a.size), share(a.angles), share(a.profile)]
+    [
+        share(a.size),
+        share(a.angles),
+        share(a.profile),
+        share(a.interreflection),
+    ]
 }
 
 /// The model's exitant flux over the truth's, per channel, from an exit-angle sweep: the
@@ -324,7 +370,9 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
          `pathtrace` (the model's integral) over `volpath`'s (the truth), per channel \
          (R / G / B) with standard errors, on controlled set-ups; each mean rendered to about \
          {:.1} % relative standard error in each channel. \"single\" is single scattering's \
-         share of the truth (`volpath --scattering single`). Reduced mean free paths (R / G / \
+         share of the truth (`volpath --scattering single`); \"without traded light\" is the \
+         truth without the light the object's parts trade (`volpath --reentry no`) over the \
+         truth, on the meshes (the other set-ups are convex: 1). Reduced mean free paths (R / G / \
          B): skin1 1.30 / 0.95 / 0.67 mm, marble 0.46 / 0.38 / 0.33 mm, ketchup 4.15 / 0.96 / 0.68 \
          mm.\n\n",
         MODEL.name(),
@@ -345,6 +393,7 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
                     rgb3(r.ratio(), true),
                     rgb3(r.albedo_ratio(), false),
                     rgb3(r.single_share(), false),
+                    rgb3(r.direct_share(), false),
                     format!(
                         "{} / {}",
                         md_num(Some(r.truth.seconds), 2),
@@ -359,6 +408,7 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
                 "model / truth (R / G / B)",
                 "with angular = albedo",
                 "single (R / G / B)",
+                "without traded light",
                 "s: volpath / pathtrace",
             ],
             &table,
@@ -426,18 +476,22 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
                     format!("{} ({})", f3(a.size), s3(sh[0])),
                     format!("{} ({})", f3(a.angles), s3(sh[1])),
                     format!("{} ({})", f3(a.profile), s3(sh[2])),
+                    format!("{} ({})", f3(a.interreflection), s3(sh[3])),
                     format!("{}; {}", f3(a.albedo_total), f3(a.albedo_flat)),
                 ]
             })
             .collect();
         summary.push_str(&format!(
             "`{}`'s image mean over real transport's (`volpath`), apportioned: model / truth \
-             at scale 1 = size × angles × profile, per channel R / G / B, each factor's share \
-             of the deficit in brackets (ln factor / ln total). Size: scale 1 over the flat \
-             limit (the two largest scales extrapolated as 1/scale); angles: the flat limit \
-             over the half-space lit and seen head-on (the scene's incidence and exit \
-             directions); profile: the half-space head-on (the table's own set-up: what is \
-             left is the profile and the boundary terms).\n\n",
+             at scale 1 = size × angles × profile × interreflection, per channel R / G / B, \
+             each factor's share of the deficit in brackets (ln factor / ln total). \
+             Interreflection: the truth without the light the object's parts trade \
+             (`volpath --reentry no`) over the truth, at scale 1: what a BSSRDF under direct \
+             light cannot carry. The other factors are taken against that truth without it. \
+             Size: scale 1 over the flat limit (the two largest scales extrapolated as \
+             1/scale); angles: the flat limit over the half-space lit and seen head-on (the \
+             scene's incidence and exit directions); profile: the half-space head-on (the \
+             table's own set-up: what is left is the profile and the boundary terms).\n\n",
             MODEL.name()
         ));
         summary.push_str(&md_table(
@@ -448,6 +502,7 @@ pub(crate) fn section(rows: &[DeficitRow], skipped: &[String], plan: &DeficitPla
                 "size (curvature, thin parts)",
                 "angles (incidence, exit)",
                 "profile and boundary",
+                "interreflection",
                 "with angular = albedo: scale 1; flat limit",
             ],
             &table,

@@ -71,6 +71,14 @@ pub(crate) struct Setup {
 }
 
 impl Setup {
+    /// Whether light leaving the object can meet it again from outside (interreflection
+    /// between its parts): the scaled meshes, which have concave parts. The flat set-ups (a
+    /// box), the cylinder and the sphere are convex, so their truth holds no light traded
+    /// between surfaces (`volpath --reentry no` equals `volpath` there, tested on a sphere).
+    pub fn trades_light(&self) -> bool {
+        matches!(self.kind, Kind::Scaled { scene, .. } if scene != "sphere10")
+    }
+
     /// `group-value`, for file names.
     pub fn name(&self) -> String {
         format!("{}-{}-{}", self.group, self.medium.name, self.value)

@@ -1,5 +1,5 @@
 use super::measure::{mean_over, ratio, relative_se, samples_for};
-use super::report::{DeficitRow, apportion, deficit_csv, flat_limit, flux_ratio, shares};
+use super::report::{DeficitRow, apportion, deficit_csv, flat_limit, flux_ratio, section, shares};
 use super::setups::FlatLight;
 use super::*;
 
@@ -73,6 +73,7 @@ fn row(group: &'static str, kind: Kind, value: f64, model: Rgb, truth: Rgb) -> D
         },
         truth: mean(truth, [0.0; 3]),
         single: mean([0.1; 3], [0.0; 3]),
+        direct: None,
         model: mean(model, [0.0; 3]),
         albedo: mean(model, [0.0; 3]),
         pixels: 4,
@@ -141,10 +142,12 @@ fn the_factors_multiply_to_the_deficit() {
         assert!((a.angles[c] - flat[c] / [0.9, 0.95, 1.0][c]).abs() < 1e-12);
         assert!((a.size[c] * a.angles[c] * a.profile[c] - a.total[c]).abs() < 1e-12);
     }
+    // A convex set-up trades no light: its interreflection factor is 1.
+    assert_eq!(a.interreflection, [1.0; 3]);
     // Shares of ln total add to 1, and the profile's blue share is 0 (ln 1).
     let s = shares(a);
     for c in 0..3 {
-        let sum: f64 = (0..3).map(|k| s[k][c].unwrap()).sum();
+        let sum: f64 = (0..4).map(|k| s[k][c].unwrap()).sum();
         assert!((sum - 1.0).abs() < 1e-12, "{c}: {sum}");
     }
     assert_eq!(s[2][2], Some(0.0));
@@ -153,6 +156,77 @@ fn the_factors_multiply_to_the_deficit() {
     let mut one_larger = rows.clone();
     one_larger.truncate(4);
     assert!(apportion(&one_larger).is_empty());
+}
+
+/// On a mesh that trades light between its parts, the deficit takes a fourth factor, the
+/// truth without that light over the truth (at scale 1), and size and angles are taken
+/// against the truth without it: the four multiply back to model / truth.
+#[test]
+fn traded_light_is_its_own_factor() {
+    let flat = Kind::Flat {
+        light: FlatLight::Sun(0.0),
+        view: 0.0,
+        thickness: 100.0,
+    };
+    let bunny = |scale: f64| Kind::Scaled {
+        scene: "bunny",
+        text: super::super::plan::BUNNY,
+        lighting: super::super::plan::Lighting::Quad,
+        scale,
+    };
+    let with_direct = |mut r: DeficitRow, d: Rgb| {
+        r.direct = Some(mean(d, [0.0; 3]));
+        r
+    };
+    let rows = vec![
+        row("incidence", flat, 0.0, [0.9, 0.95, 1.0], [1.0; 3]),
+        // Scale 1: the model 0.9 of the truth, the truth without traded light 0.8 of it.
+        with_direct(
+            row("bunny-quad", bunny(1.0), 1.0, [0.9; 3], [1.0; 3]),
+            [0.8, 0.85, 0.9],
+        ),
+        with_direct(
+            row("bunny-quad", bunny(16.0), 16.0, [0.9; 3], [1.0; 3]),
+            [0.75; 3],
+        ),
+        with_direct(
+            row("bunny-quad", bunny(64.0), 64.0, [0.9; 3], [1.0; 3]),
+            [0.9; 3],
+        ),
+    ];
+    assert!(rows[1].setup.trades_light() && !rows[0].setup.trades_light());
+    let a = apportion(&rows);
+    assert_eq!(a.len(), 1);
+    let a = &a[0];
+    assert_eq!(a.interreflection, [0.8, 0.85, 0.9]);
+    // Against the truth without traded light: 0.9/0.75 = 1.2 at 16, 1.0 at 64, flat limit
+    // 1.0 − 0.2/3.
+    let flat = 1.0 - 0.2 / 3.0;
+    for c in 0..3 {
+        assert!((a.flat[c] - flat).abs() < 1e-12, "{:?}", a.flat);
+        let size = 0.9 / [0.8, 0.85, 0.9][c] / flat;
+        assert!((a.size[c] - size).abs() < 1e-12, "{:?}", a.size);
+        let product = a.size[c] * a.angles[c] * a.profile[c] * a.interreflection[c];
+        assert!((product - a.total[c]).abs() < 1e-12, "{c}: {product}");
+    }
+    // The report names the factor and the CSV carries it (none for the convex row).
+    let csv = String::from(deficit_csv(&rows));
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "direct_g").unwrap();
+    let cells: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(cells[0][col], "");
+    assert_eq!(cells[1][col].parse::<f64>().unwrap(), 0.85);
+    let plan = super::plan(true);
+    let section = section(&rows, &[], &plan);
+    assert!(
+        section.summary.contains("interreflection"),
+        "{}",
+        section.summary
+    );
 }
 
 /// Every column of `deficit.csv` is documented in `docs/compare.md`.

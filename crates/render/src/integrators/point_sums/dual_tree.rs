@@ -37,11 +37,12 @@ use super::{
     Counts, accepts, add_samples, eps_sweep, for_each_dual_object, illumination_tree_bytes,
     illumination_trees, pixel_trees, rd_times, shading_points, task_slices,
 };
+use super::{LitSamples, lit_samples};
 use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
 use crate::integrators::options::{
-    MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
+    BOUNCES, MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
 };
 use crate::integrators::{
     Integrator, Layer, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep,
@@ -57,9 +58,10 @@ use sss_hierarchy::{IrradianceTree, KdNode, PixelPoint, PixelTree};
 use sss_scene::Scene;
 
 /// The options: the irradiance-sample options, ε and ρ.
-pub const OPTIONS: [OptionSpec; 4] = [
+pub const OPTIONS: [OptionSpec; 5] = [
     SPACING,
     MAX_SAMPLES,
+    BOUNCES,
     SOLID_ANGLE,
     OptionSpec {
         name: "rho",
@@ -307,7 +309,11 @@ impl Integrator for DualTree {
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
         check_radial(frame, METHOD.name)?;
-        let samples = frame.irradiance_samples(&self.irradiance);
+        let LitSamples {
+            samples,
+            stats: light_stats,
+            ..
+        } = lit_samples(frame, &self.irradiance)?;
         let trees = frame.timed("illumination_tree", || illumination_trees(frame, &samples));
         let points = frame.timed("fourier", || shading_points(frame))?;
         let pixel_trees = pixel_trees(frame, &points);
@@ -362,6 +368,7 @@ impl Integrator for DualTree {
         // background objects) now.
         progress.advance(frame.gbuffer.samples.len() as u64 - shaded_points);
         let mut stats = counts.stats("node_pairs_visited");
+        stats.extend(light_stats);
         let rates: Vec<f64> = points
             .iter()
             .flatten()

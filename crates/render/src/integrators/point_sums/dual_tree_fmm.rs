@@ -106,18 +106,18 @@ use super::{
     eps_sweep, for_each_dual_object, illumination_tree_bytes, illumination_trees, node_balls,
     pair_ball, pixel_point, pixel_trees, rd_times, shading_points, task_slices, tree_balls,
 };
+use super::{LitSamples, lit_samples};
 use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
 use crate::integrators::options::{
-    MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
+    BOUNCES, MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
 };
 use crate::integrators::{
     Integrator, Method, MethodOptions, OptionKind, OptionSpec, Shaded, Stat, Sweep, add_scaled,
     add_weighted, check_radial_balls,
 };
 use crate::irradiance::IrradianceSettings;
-use crate::local_radius::frame_balls;
 use crate::progress::Progress;
 use crate::shading::{DISK_FAR_RATIO, TranslucentShading};
 use glam::DVec3;
@@ -130,9 +130,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The options: the irradiance-sample options, ε, the ratio ε_px / ε, the expansion order and
 /// the optional ρ / s_p cap.
-pub const OPTIONS: [OptionSpec; 6] = [
+pub const OPTIONS: [OptionSpec; 7] = [
     SPACING,
     MAX_SAMPLES,
+    BOUNCES,
     SOLID_ANGLE,
     OptionSpec {
         name: "px-ratio",
@@ -849,8 +850,11 @@ impl Integrator for DualTreeFmm {
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
         check_radial_balls(frame, METHOD.name)?;
-        let samples = frame.irradiance_samples(&self.irradiance);
-        let balls = frame_balls(frame, &frame.samples_by_object(&samples))?;
+        let LitSamples {
+            samples,
+            balls,
+            stats: light_stats,
+        } = lit_samples(frame, &self.irradiance)?;
         let trees = frame.timed("illumination_tree", || illumination_trees(frame, &samples));
         let tree_balls = tree_balls(&balls, &trees);
         let points = if self.cap_rho > 0.0 {
@@ -938,6 +942,7 @@ impl Integrator for DualTreeFmm {
         });
         progress.advance(frame.gbuffer.samples.len() as u64 - shaded_points);
         let mut stats = counts.stats("node_pairs_visited");
+        stats.extend(light_stats);
         stats.push(Stat {
             name: "sample_expansions",
             value: sample_expansions.load(Ordering::Relaxed) as f64,

@@ -13,6 +13,7 @@
 //! resolutions where shading every pixel would take too long, scored with
 //! [`crate::metrics::subset_error`].
 
+use super::{LitSamples, lit_samples};
 use crate::Error;
 use crate::frame::Frame;
 use crate::frame::assembled_subsurface;
@@ -22,7 +23,7 @@ use crate::integrators::options::SAMPLE_OPTIONS;
 use crate::integrators::options::sample_settings;
 use crate::integrators::{Integrator, Method, MethodOptions, Shaded, Stat, Sweep, add_weighted};
 use crate::irradiance::{IrradianceSample, IrradianceSettings, ObjectSamples};
-use crate::local_radius::{FrameBalls, LocalBalls, frame_balls};
+use crate::local_radius::{FrameBalls, LocalBalls};
 use crate::progress::Progress;
 use crate::shading::TranslucentShading;
 use rayon::prelude::*;
@@ -90,9 +91,12 @@ impl Integrator for Exact {
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
-        let samples = frame.irradiance_samples(&self.irradiance);
+        let LitSamples {
+            samples,
+            balls,
+            stats: light_stats,
+        } = lit_samples(frame, &self.irradiance)?;
         let by_object = frame.samples_by_object(&samples);
-        let balls = frame_balls(frame, &by_object)?;
         let values: Vec<Rgb> = frame.timed("shading", || {
             frame
                 .gbuffer
@@ -119,6 +123,7 @@ impl Integrator for Exact {
             name: "sample_pairs",
             value: evaluations as f64,
         }];
+        stats.extend(light_stats);
         let mut layers = Vec::new();
         super::ball_outputs(frame, &balls, &mut stats, &mut layers);
         Ok(Shaded {
@@ -245,9 +250,8 @@ pub fn shade_subset(
             "subset reference: pixel {bad} is past the image's {n} pixels"
         )));
     }
-    let samples = frame.irradiance_samples(irradiance);
+    let LitSamples { samples, balls, .. } = lit_samples(frame, irradiance)?;
     let by_object = frame.samples_by_object(&samples);
-    let balls = frame_balls(frame, &by_object)?;
     let gb = &frame.gbuffer;
     Ok(frame.timed("shading", || {
         pixels

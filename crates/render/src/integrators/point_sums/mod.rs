@@ -10,14 +10,15 @@
 pub mod dual_tree;
 pub mod dual_tree_fmm;
 pub mod exact;
+pub mod interreflection;
 pub mod single_tree;
 
-use super::{Layer, Stat};
+use super::{Layer, Stat, add_scaled};
 use crate::Error;
 use crate::frame::Frame;
 use crate::gbuffer::GSample;
-use crate::irradiance::ObjectSamples;
-use crate::local_radius::{FrameBalls, LocalBalls};
+use crate::irradiance::{IrradianceSettings, ObjectSamples};
+use crate::local_radius::{FrameBalls, LocalBalls, frame_balls};
 use crate::sampling_rate::object_rates;
 pub use crate::sampling_rate::{curvature_at_hits, pixel_footprint};
 use crate::shading::TranslucentShading;
@@ -25,6 +26,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::{BallFamily, Rgb};
 use sss_hierarchy::{IrradiancePoint, IrradianceTree, KdNode, KdTree, PixelPoint, PixelTree};
+use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Irradiance samples per leaf of the illumination tree. Small, because a leaf that is not
@@ -103,6 +105,107 @@ pub(crate) fn illumination_trees(
             })
         })
         .collect()
+}
+
+/// The irradiance samples a point sum reads, their balls and the stats of their light
+/// ([`lit_samples`]).
+pub(crate) struct LitSamples {
+    /// Per visible translucent object, its samples.
+    pub(crate) samples: Arc<Vec<ObjectSamples>>,
+    /// The samples' and the G-buffer's balls (none without `sphere_radius = "local"`).
+    pub(crate) balls: FrameBalls,
+    /// The gather's stats (none without bounces).
+    pub(crate) stats: Vec<Stat>,
+}
+
+/// The irradiance samples a point sum reads for `settings`: the frame's samples lit by the
+/// lights ([`Frame::irradiance_samples`]), and with `settings.bounces` > 0 lit also by that
+/// many bounces of the light the surfaces trade ([`interreflection`]; built once per frame
+/// and settings, timed as stage `bounces`).
+pub(crate) fn lit_samples(
+    frame: &Frame<'_>,
+    settings: &IrradianceSettings,
+) -> Result<LitSamples, Error> {
+    let direct = frame.irradiance_samples(&IrradianceSettings {
+        bounces: 0,
+        ..*settings
+    });
+    let balls = frame_balls(frame, &frame.samples_by_object(&direct))?;
+    if settings.bounces == 0 {
+        return Ok(LitSamples {
+            samples: direct,
+            balls,
+            stats: Vec::new(),
+        });
+    }
+    let (samples, figures) = frame.bounced_samples(settings, || {
+        frame.timed("bounces", || {
+            interreflection::bounced(frame, &direct, &balls, settings.bounces)
+        })
+    })?;
+    let stats = figures
+        .into_iter()
+        .map(|(name, value)| Stat { name, value })
+        .collect();
+    Ok(LitSamples {
+        samples,
+        balls,
+        stats,
+    })
+}
+
+/// The sum at `x` over the tree, by Algorithm 1 (before the exit weight). With `balls` (the
+/// tree's [`TreeBalls`] and x's radius in mm), each pair takes its own ball: a node is accepted
+/// only where one radius stands for its samples, and a leaf sums each pair with its own.
+pub(crate) fn single(
+    tree: &IrradianceTree,
+    x: DVec3,
+    eps: f64,
+    sh: &TranslucentShading,
+    counts: &Counts,
+    balls: Option<(&TreeBalls<'_>, f64)>,
+) -> Rgb {
+    let mut acc = [0.0; 3];
+    if tree.tree.nodes.is_empty() {
+        return acc;
+    }
+    let (mut visits, mut clusters, mut singles) = (0u64, 0u64, 0u64);
+    let mut stack: Vec<u32> = Vec::with_capacity(64);
+    stack.push(0);
+    while let Some(k) = stack.pop() {
+        visits += 1;
+        let node = &tree.tree.nodes[k as usize];
+        let cl = &tree.clusters[k as usize];
+        let d2 = (cl.position - x).length_squared();
+        // The node's one ball, if its samples share one (always, with one profile).
+        let ball = match balls {
+            Some((b, rx)) => b.nodes[k as usize].map(|r| Some(pair_ball(r, rx))),
+            None => Some(None),
+        };
+        if let Some(ball) = ball
+            && accepts(cl.area, d2, eps)
+            && !inside(node, x)
+        {
+            let rd = match (ball, balls) {
+                (Some(pair), Some((b, _))) => sh.rd_sample_ball(d2.sqrt(), cl.area, b.family, pair),
+                _ => sh.rd_sample_scene(d2.sqrt(), cl.area),
+            };
+            add_scaled(&mut acc, rd_times(rd, cl.flux), 1.0);
+            clusters += 1;
+        } else if node.is_leaf() {
+            match balls {
+                Some((b, rx)) => b.add_samples(&mut acc, tree, node, x, rx, sh),
+                None => add_samples(&mut acc, tree.points_of(node), x, sh),
+            }
+            singles += node.len() as u64;
+        } else {
+            // Right first, so the left subtree is summed first.
+            stack.push(node.right);
+            stack.push(node.left);
+        }
+    }
+    counts.add(visits, clusters, singles);
+    acc
 }
 
 /// Bytes of the illumination trees for the per-object sample estimates of

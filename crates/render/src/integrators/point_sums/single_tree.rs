@@ -1,15 +1,18 @@
 //! The single-tree traversal of Jensen & Buhler 2002 ("A rapid hierarchical rendering
 //! technique for translucent materials", §4), as Algorithm 1 of Milaenen et al. 2019 states
 //! it: at every shading point x_o, walk a kd-tree over the object's irradiance samples
-//! ([`IrradianceTree`]) and let a node stand for all its samples when it subtends a small
-//! solid angle, Δω = A_I / ‖x_o − p_I‖² < ε, and x_o is outside its bounding box.
+//! ([`sss_hierarchy::IrradianceTree`]) and let a node stand for all its samples when it
+//! subtends a small solid angle, Δω = A_I / ‖x_o − p_I‖² < ε, and x_o is outside its bounding
+//! box (the traversal is the family's, in its parent module: the bounces of
+//! [`super::interreflection`] evaluate the exitance with it too).
 //!
 //! The contribution of an accepted node is R_d(‖x_o − p_I‖) Σ E_i A_i (its flux at its
 //! irradiance-weighted position); a leaf that is not accepted adds its samples one by one,
-//! exactly as [`super::exact`] does (the same [`TranslucentShading::rd_sample_scene`]). So at
-//! ε → 0 the traversal equals `exact` over the same samples to rounding, and its error
-//! against `exact` is the hierarchy's error alone. The test is applied to leaves too (as in
-//! Mitsuba's `irrtree`): a distant leaf is one evaluation, not `leaf` evaluations.
+//! exactly as [`super::exact`] does (the same
+//! [`crate::shading::TranslucentShading::rd_sample_scene`]). So at ε → 0 the traversal equals
+//! `exact` over the same samples to rounding, and its error against `exact` is the
+//! hierarchy's error alone. The test is applied to leaves too (as in Mitsuba's `irrtree`): a
+//! distant leaf is one evaluation, not `leaf` evaluations.
 //!
 //! Radial models only (a node's flux is summed without incident directions): the directional
 //! dipole and drifting materials are refused with an error naming the material. A material
@@ -19,31 +22,26 @@
 //! with its own, so at ε → 0 the traversal still equals `exact`.
 
 use super::{
-    Counts, TreeBalls, accepts, add_samples, ball_outputs, eps_sweep, illumination_tree_bytes,
-    illumination_trees, inside, pair_ball, rd_times, tree_balls,
+    Counts, LitSamples, ball_outputs, eps_sweep, illumination_tree_bytes, illumination_trees,
+    lit_samples, single, tree_balls,
 };
 use crate::Error;
 use crate::frame::Frame;
 use crate::integrators::Converges;
 use crate::integrators::options::{
-    MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
+    BOUNCES, MAX_SAMPLES, SOLID_ANGLE, SPACING, declared, eps_option, sample_settings,
 };
 use crate::integrators::{
-    Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep, add_scaled, add_weighted,
-    check_radial_balls,
+    Integrator, Method, MethodOptions, OptionSpec, Shaded, Sweep, add_weighted, check_radial_balls,
 };
 use crate::irradiance::IrradianceSettings;
-use crate::local_radius::frame_balls;
 use crate::progress::Progress;
-use crate::shading::TranslucentShading;
-use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
-use sss_hierarchy::IrradianceTree;
 use sss_scene::Scene;
 
 /// The options: the irradiance-sample options and ε.
-pub const OPTIONS: [OptionSpec; 3] = [SPACING, MAX_SAMPLES, SOLID_ANGLE];
+pub const OPTIONS: [OptionSpec; 4] = [SPACING, MAX_SAMPLES, BOUNCES, SOLID_ANGLE];
 
 /// The registry entry.
 pub const METHOD: Method = Method {
@@ -87,60 +85,6 @@ impl SingleTree {
     }
 }
 
-/// The sum at `x` over the tree, by Algorithm 1 (before the exit weight). With `balls` (the
-/// tree's [`TreeBalls`] and x's radius in mm), each pair takes its own ball: a node is accepted
-/// only where one radius stands for its samples, and a leaf sums each pair with its own.
-pub(crate) fn single(
-    tree: &IrradianceTree,
-    x: DVec3,
-    eps: f64,
-    sh: &TranslucentShading,
-    counts: &Counts,
-    balls: Option<(&TreeBalls<'_>, f64)>,
-) -> Rgb {
-    let mut acc = [0.0; 3];
-    if tree.tree.nodes.is_empty() {
-        return acc;
-    }
-    let (mut visits, mut clusters, mut singles) = (0u64, 0u64, 0u64);
-    let mut stack: Vec<u32> = Vec::with_capacity(64);
-    stack.push(0);
-    while let Some(k) = stack.pop() {
-        visits += 1;
-        let node = &tree.tree.nodes[k as usize];
-        let cl = &tree.clusters[k as usize];
-        let d2 = (cl.position - x).length_squared();
-        // The node's one ball, if its samples share one (always, with one profile).
-        let ball = match balls {
-            Some((b, rx)) => b.nodes[k as usize].map(|r| Some(pair_ball(r, rx))),
-            None => Some(None),
-        };
-        if let Some(ball) = ball
-            && accepts(cl.area, d2, eps)
-            && !inside(node, x)
-        {
-            let rd = match (ball, balls) {
-                (Some(pair), Some((b, _))) => sh.rd_sample_ball(d2.sqrt(), cl.area, b.family, pair),
-                _ => sh.rd_sample_scene(d2.sqrt(), cl.area),
-            };
-            add_scaled(&mut acc, rd_times(rd, cl.flux), 1.0);
-            clusters += 1;
-        } else if node.is_leaf() {
-            match balls {
-                Some((b, rx)) => b.add_samples(&mut acc, tree, node, x, rx, sh),
-                None => add_samples(&mut acc, tree.points_of(node), x, sh),
-            }
-            singles += node.len() as u64;
-        } else {
-            // Right first, so the left subtree is summed first.
-            stack.push(node.right);
-            stack.push(node.left);
-        }
-    }
-    counts.add(visits, clusters, singles);
-    acc
-}
-
 impl Integrator for SingleTree {
     fn name(&self) -> &'static str {
         METHOD.name
@@ -163,8 +107,11 @@ impl Integrator for SingleTree {
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {
         check_radial_balls(frame, METHOD.name)?;
-        let samples = frame.irradiance_samples(&self.irradiance);
-        let balls = frame_balls(frame, &frame.samples_by_object(&samples))?;
+        let LitSamples {
+            samples,
+            balls,
+            stats: light_stats,
+        } = lit_samples(frame, &self.irradiance)?;
         let trees = frame.timed("illumination_tree", || illumination_trees(frame, &samples));
         let tree_balls = tree_balls(&balls, &trees);
         let counts = Counts::default();
@@ -192,6 +139,7 @@ impl Integrator for SingleTree {
                 .collect()
         });
         let mut stats = counts.stats("nodes_visited");
+        stats.extend(light_stats);
         let mut layers = Vec::new();
         ball_outputs(frame, &balls, &mut stats, &mut layers);
         Ok(Shaded {
