@@ -328,11 +328,12 @@ impl TranslucentShading {
 
     /// [`rd_sample_scene`](Self::rd_sample_scene) of the profile `family` gives the ball of
     /// `radius` mm (NaN: the half-space's profile, unchanged), per scene unit²: one pair's
-    /// term of [`add_point_sum_local`](Self::add_point_sum_local), and the trees' value for a
-    /// node whose samples share one ball. Near the shading point it is the disk's average of
-    /// the ball's profile max(0, R_d + Δ); far, the corrected point value of R_d with Δ at r
-    /// added. (Δ at r added to the disk's average of R_d, a point value beside the average of
-    /// a peaked profile, took up to four fifths of a coarse sample's own term away.)
+    /// term of [`add_point_sum_local`](Self::add_point_sum_local) (a tree node's value is
+    /// [`rd_cluster_ball`](Self::rd_cluster_ball)). Near the shading point it is the disk's
+    /// average of the ball's profile max(0, R_d + Δ); far, the corrected point value of R_d
+    /// with Δ at r added. (Δ at r added to the disk's average of R_d, a point value beside the
+    /// average of a peaked profile, took up to four fifths of a coarse sample's own term away,
+    /// and was 5 % off two disk radii away.)
     #[inline]
     pub fn rd_sample_ball(
         &self,
@@ -344,13 +345,43 @@ impl TranslucentShading {
         if !(radius > 0.0) || radius.is_nan() {
             return self.rd_sample_scene(r, area);
         }
+        self.rd_sample_with(r, area, self.ball_shape(family, radius))
+    }
+
+    /// The ball of `radius` mm's profile from the half-space's, in scene units:
+    /// (r, R_d(r)) ↦ `family`'s reshaped value ([`sss_bssrdf::BallFamily::reshape_rgb`]).
+    fn ball_shape<'f>(
+        &self,
+        family: &'f sss_bssrdf::BallFamily,
+        radius: f64,
+    ) -> impl Fn(f64, Rgb) -> Rgb + 'f {
         let u = self.units_per_mm;
         let [s, _, _] = scene_unit_factors(u);
-        self.rd_sample_with(r, area, |x, rd| {
+        move |x, rd| {
             family
                 .reshape_rgb(x / u, radius, rd.map(|v| v / s))
                 .map(|v| v * s)
-        })
+        }
+    }
+
+    /// A tree node's value under the ball of `radius` mm (NaN: the half-space's profile): the
+    /// node's [`rd_sample_scene`](Self::rd_sample_scene) over its area with the ball's
+    /// difference at the node's distance added. A node stands for samples spread over its
+    /// disk, each summed far from its own (the trees accept a node only where it subtends a
+    /// small solid angle), so what it approximates is the sum of their far values, not the
+    /// disk's average of the reshaped profile that a sample near the shading point takes
+    /// ([`rd_sample_ball`](Self::rd_sample_ball)): on a 10 mm ketchup sphere under the
+    /// environment, that average over the nodes' disks put the trees 1.1 % below `exact` in
+    /// the red, this value 0.1 %.
+    #[inline]
+    pub fn rd_cluster_ball(
+        &self,
+        r: f64,
+        area: f64,
+        family: &sss_bssrdf::BallFamily,
+        radius: f64,
+    ) -> Rgb {
+        self.ball_shape(family, radius)(r.abs(), self.rd_sample_scene(r, area))
     }
 
     /// The far branch of [`rd_sample_scene`](Self::rd_sample_scene) with its first two
@@ -1211,7 +1242,8 @@ mod tests {
     /// that profile over the disk; not the disk's average of R_d with the difference at the
     /// centre's distance added, which near a peaked R_d is a point value beside an average
     /// (on a 450 mm marble head at the default spacing it took four fifths of a sample's own
-    /// green term away). Far, the reshaped point value with its correction, as without a ball.
+    /// green term away; here it is 2.7 % off at the disk's centre and 5 % two radii away).
+    /// Far, the reshaped point value with its correction, as without a ball.
     #[test]
     fn a_ball_reshapes_the_profile_before_the_disk_averages_it() {
         // skin1, whose walk resolves the difference at these distances (ketchup's green and

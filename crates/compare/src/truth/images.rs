@@ -82,7 +82,8 @@ pub(crate) fn write_plot(path: &Path, case: &str, runs: &[TruthRun]) -> Result<(
     let fast = FAST
         .iter()
         .map(|&name| (name, FAST_MODEL.name()))
-        .chain(LOCAL_FAST.iter().map(|&name| (name, LOCAL_FAST_MODEL)));
+        .chain(LOCAL_FAST.iter().map(|&name| (name, LOCAL_FAST_MODEL)))
+        .chain(LOCAL_FAST.iter().map(|&name| (name, BOUNCE_FAST_MODEL)));
     for (i, (name, model)) in fast.enumerate() {
         let p = points(&|r| r.method == name && r.model == model);
         if !p.is_empty() {
@@ -107,7 +108,7 @@ pub(crate) fn write_plot(path: &Path, case: &str, runs: &[TruthRun]) -> Result<(
             series.push(
                 Series::line(format!("Cycles {}", mode.name()), p)
                     .with_style(SeriesStyle::Dashed)
-                    .with_color(colour(FAST.len() + LOCAL_FAST.len() + i)),
+                    .with_color(colour(FAST.len() + 2 * LOCAL_FAST.len() + i)),
             );
         }
     }

@@ -8,7 +8,8 @@
 //!   discretises, its own noise removed: the model's floor against the truth);
 //! - the fast methods (`dual-tree-fmm`, `manylight`, `separable`) over their sweeps, with
 //!   `mc-table`, and `dual-tree-fmm` with each point's own ball too
-//!   (`mc-table+albedo+local`);
+//!   (`mc-table+albedo+local`), and with one bounce of the light the surfaces trade
+//!   (`mc-table+albedo+local+bounce`);
 //! - `volpath` at increasing paths per pixel, with another seed, on the same axes, so the
 //!   report reads off for each method and model the time at which brute force reaches the same
 //!   error ([`Crossover`]).
@@ -50,8 +51,8 @@ use plan::{
 };
 use report::{CaseResult, section, truth_csv};
 use runs::{
-    EXACT_SAMPLES, FAST, FAST_MODEL, LOCAL_FAST, LOCAL_FAST_MODEL, PATHTRACE_SPP, TruthRun,
-    run_case,
+    BOUNCE_FAST_MODEL, EXACT_SAMPLES, FAST, FAST_MODEL, LOCAL_FAST, LOCAL_FAST_MODEL,
+    PATHTRACE_SPP, TruthRun, run_case,
 };
 use scoring::{Crossover, Score, score, score_without_noise};
 use sss_bssrdf::{Medium, ModelKind, Rgb};

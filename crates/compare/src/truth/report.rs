@@ -93,7 +93,9 @@ pub(crate) fn section(
          of the medium in the mesh (checked against Mitsuba 3 and MCML), rendered until its own \
          relative noise is small; every model under `exact` (its sum) and `pathtrace` (the \
          integral it discretises), the fast methods with `mc-table` over their sweeps \
-         (`dual-tree-fmm` with `mc-table+albedo+local` too: each point's own ball), and \
+         (`dual-tree-fmm` with `mc-table+albedo+local` too: each point's own ball; and \
+         `mc-table+albedo+local+bounce`, the same with one bounce of the light the surfaces \
+         trade, `--bounces 1`), and \
          `volpath` at fewer paths, all scored \
          over the pixels inside the silhouette (a pixel and its eight neighbours covered) with \
          the reference's noise removed. *volpath to the same \

@@ -1,6 +1,7 @@
 //! The runs of one case, each scored against its reference: every model under `exact`, the
 //! fast methods over their sweeps (with `mc-table`, the model the scene files name, and those
-//! that take it with each point's own ball), and
+//! that take it with each point's own ball, with and without one bounce of the light the
+//! surfaces trade), and
 //! `volpath` itself over its paths per pixel (with another seed than the reference's, so its
 //! error is its own noise).
 
@@ -43,8 +44,15 @@ pub const LOCAL_MODEL: &str = "mc-table+albedo+local+drift";
 pub const LOCAL_FAST_MODEL: &str = "mc-table+albedo+local";
 
 /// The fast methods that take each point's own ball, swept with [`LOCAL_FAST_MODEL`] besides
-/// [`FAST_MODEL`].
+/// [`FAST_MODEL`], and with [`BOUNCE_FAST_MODEL`].
 pub const LOCAL_FAST: [&str; 1] = ["dual-tree-fmm"];
+
+/// The name of [`LOCAL_FAST_MODEL`] rendered with one bounce of the light the surfaces trade
+/// (`--bounces 1`) in the runs' `model` column, swept by [`LOCAL_FAST`] too.
+pub const BOUNCE_FAST_MODEL: &str = "mc-table+albedo+local+bounce";
+
+/// The `--bounces` of [`BOUNCE_FAST_MODEL`].
+pub const FAST_BOUNCES: u32 = 1;
 
 /// The models beyond [`ModelKind::ALL`] the experiment scores, in report order.
 pub const VARIANTS: [&str; 4] = [ALBEDO_MODEL, BALL_MODEL, DRIFT_MODEL, LOCAL_MODEL];
@@ -224,18 +232,26 @@ pub(crate) fn run_case(
         with_local_balls(&mut local);
         let jobs = FAST
             .iter()
-            .map(|&name| (name, &plain, FAST_MODEL.name()))
+            .map(|&name| (name, &plain, FAST_MODEL.name(), 0))
             .chain(
                 LOCAL_FAST
                     .iter()
-                    .map(|&name| (name, &local, LOCAL_FAST_MODEL)),
+                    .map(|&name| (name, &local, LOCAL_FAST_MODEL, 0)),
+            )
+            .chain(
+                LOCAL_FAST
+                    .iter()
+                    .map(|&name| (name, &local, BOUNCE_FAST_MODEL, FAST_BOUNCES)),
             );
-        for (name, scene, model) in jobs {
+        for (name, scene, model, bounces) in jobs {
             let m = integrators::method(name).map_err(|e| Error(e.to_string()))?;
             for v in (m.sweep.values)(cfg.quick) {
+                let mut options = MethodOptions::new().with(m.sweep.option, v);
+                if bounces > 0 {
+                    options = options.with("bounces", bounces);
+                }
                 let method =
-                    integrators::build(name, &MethodOptions::new().with(m.sweep.option, v))
-                        .map_err(|e| Error(e.to_string()))?;
+                    integrators::build(name, &options).map_err(|e| Error(e.to_string()))?;
                 match render(scene, method.as_ref(), &settings(cfg.seed), &NoProgress) {
                     Ok(r) => out.runs.push(row(m.name, model, m.sweep.label, v, &r)),
                     Err(sss_render::Error::Unsupported(why)) => {

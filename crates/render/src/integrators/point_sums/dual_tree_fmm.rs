@@ -407,11 +407,19 @@ impl Fmm<'_> {
             .unwrap_or(f64::NAN)
     }
 
-    /// The point value of a source of `area` at distance `r` with the pair's ball `pair`
-    /// (NaN: the half-space's profile).
-    fn value(&self, r: f64, area: f64, pair: f64) -> Rgb {
+    /// The value of a source of `area` at distance `r` with the pair's ball `pair` (NaN: the
+    /// half-space's profile): one irradiance sample's (`single`,
+    /// [`TranslucentShading::rd_sample_ball`]) or a cluster's
+    /// ([`TranslucentShading::rd_cluster_ball`]).
+    fn value(&self, r: f64, area: f64, pair: f64, single: bool) -> Rgb {
         match &self.balls {
-            Some(b) if !pair.is_nan() => self.sh.rd_sample_ball(r, area, b.tree.family, pair),
+            Some(b) if !pair.is_nan() => {
+                if single {
+                    self.sh.rd_sample_ball(r, area, b.tree.family, pair)
+                } else {
+                    self.sh.rd_cluster_ball(r, area, b.tree.family, pair)
+                }
+            }
             _ => self.sh.rd_sample_scene(r, area),
         }
     }
@@ -499,7 +507,7 @@ impl Fmm<'_> {
                 for k in sn.start as usize..sn.end as usize {
                     let x = self.points[k].position;
                     let pair = pair_ball(ball, self.point_ball(k));
-                    let rd = self.value((cl.position - x).length(), cl.area, pair);
+                    let rd = self.value((cl.position - x).length(), cl.area, pair, false);
                     add_scaled(&mut t.acc[k - t.start], rd_times(rd, cl.flux), 1.0);
                 }
                 t.clusters += sn.len() as u64;
@@ -590,7 +598,7 @@ impl Fmm<'_> {
             if !(r - h > 0.0) || (r - h < end && end <= r + h) {
                 return None;
             }
-            let [lo, mid, hi] = [r - h, r, r + h].map(|x| self.value(x, area, pair));
+            let [lo, mid, hi] = [r - h, r, r + h].map(|x| self.value(x, area, pair, near));
             let c = 1.0 / (h * h);
             let d = 0.5 / h;
             return Some(std::array::from_fn(|ch| {

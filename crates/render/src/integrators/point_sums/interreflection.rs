@@ -334,3 +334,103 @@ impl<'a> Nearest<'a> {
             .map(|(_, i)| i)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::irradiance::IrradianceSettings;
+    use sss_bssrdf::fresnel::ft_dielectric;
+    use sss_scene::load_str;
+
+    /// A 200 × 200 × 20 mm box of skin1 (η 1.4) under a uniform environment of radiance 1, seen
+    /// from above.
+    fn slab() -> sss_scene::Scene {
+        let text = "[camera]\nposition = [0.0, 0.0, 300.0]\ntarget = [0.0, 0.0, 0.0]\n\
+                    fov = 10.0\nresolution = [8, 8]\n\n\
+                    [[lights]]\ntype = \"environment\"\nradiance = 1.0\n\n\
+                    [materials.m]\ntype = \"translucent\"\nmodel = \"mc-table\"\n\
+                    preset = \"skin1\"\nunits_per_mm = 1.0\n\n\
+                    [[objects]]\nmaterial = \"m\"\nshape = \"box\"\n\
+                    size = [200.0, 200.0, 20.0]\ntransform = { translate = [0.0, 0.0, -10.0] }\n";
+        load_str(text, "slab.toml", None, &Default::default()).unwrap()
+    }
+
+    /// A ray coming down onto the slab at θ brings back the environment reflected by its
+    /// smooth surface, F_r(η, cos θ) (Fresnel's equations), plus the exitance of the nearest
+    /// sample times the exit weight W_o = F_t(η, cos θ)/(cπ) (Fresnel's weights); a ray that
+    /// goes up meets nothing and brings back nothing.
+    #[test]
+    fn a_ray_brings_back_the_mirrored_environment_and_the_weighted_exitance() {
+        let scene = slab();
+        let frame = Frame::prepare(&scene, 1);
+        let settings = IrradianceSettings {
+            spacing_mfp: 8.0,
+            max_samples: 20_000,
+            ..IrradianceSettings::default()
+        };
+        let samples = frame.irradiance_samples(&settings);
+        let emitters = Emitters::new(&scene.lights);
+        let m = [0.5, 1.0, 2.0];
+        let exitance: Vec<Vec<Rgb>> = samples.iter().map(|s| vec![m; s.samples.len()]).collect();
+        let nearest: Vec<Option<Nearest>> = vec![Some(Nearest::new(&samples[0]))];
+        let by_object = vec![Some(0)];
+        let sh = frame.shading_of(0).unwrap();
+        let unsampled = AtomicU64::new(0);
+        let p = DVec3::new(0.0, 0.0, 5.0);
+        let along = |dir: DVec3| {
+            radiance_along(
+                &frame,
+                &emitters,
+                &exitance,
+                &nearest,
+                &by_object,
+                p,
+                DVec3::Z,
+                dir,
+                &unsampled,
+            )
+        };
+        for theta in [0.0f64, 30.0, 60.0, 80.0] {
+            let t = theta.to_radians();
+            let dir = DVec3::new(t.sin(), 0.0, -t.cos());
+            let l = along(dir);
+            let c = t.cos();
+            let w = ft_dielectric(c, sh.eta) * sh.norm;
+            for ch in 0..3 {
+                let want = fr_dielectric(c, sh.eta) + w * m[ch];
+                assert!(
+                    (l[ch] - want).abs() < 1e-9 * want,
+                    "θ {theta}: channel {ch} {} against {want}",
+                    l[ch]
+                );
+            }
+        }
+        assert_eq!(unsampled.load(Ordering::Relaxed), 0);
+        let up = along(DVec3::Z);
+        assert_eq!(up, [0.0; 3]);
+    }
+
+    /// Malley's directions: unit, on the normal's side, with E[cos θ] = 2/3 and E[cos² θ] = 1/2
+    /// (the cosine-weighted hemisphere), on a grid of u.
+    #[test]
+    fn cosine_directions_have_the_cosine_weighted_moments() {
+        let n = DVec3::new(0.3, -0.5, 0.8).normalize();
+        let k = 200;
+        let (mut m1, mut m2) = (0.0, 0.0);
+        for i in 0..k {
+            for j in 0..k {
+                let u1 = (i as f64 + 0.5) / k as f64;
+                let u2 = (j as f64 + 0.5) / k as f64;
+                let d = cosine_about(n, u1, u2);
+                assert!((d.length() - 1.0).abs() < 1e-12);
+                let c = d.dot(n);
+                assert!(c >= 0.0);
+                m1 += c;
+                m2 += c * c;
+            }
+        }
+        let count = (k * k) as f64;
+        assert!((m1 / count - 2.0 / 3.0).abs() < 1e-4, "{}", m1 / count);
+        assert!((m2 / count - 0.5).abs() < 1e-4, "{}", m2 / count);
+    }
+}

@@ -187,7 +187,9 @@ pub(crate) fn single(
             && !inside(node, x)
         {
             let rd = match (ball, balls) {
-                (Some(pair), Some((b, _))) => sh.rd_sample_ball(d2.sqrt(), cl.area, b.family, pair),
+                (Some(pair), Some((b, _))) => {
+                    sh.rd_cluster_ball(d2.sqrt(), cl.area, b.family, pair)
+                }
                 _ => sh.rd_sample_scene(d2.sqrt(), cl.area),
             };
             add_scaled(&mut acc, rd_times(rd, cl.flux), 1.0);
