@@ -356,9 +356,10 @@ mod tests {
     }
 
     /// A ray coming down onto the slab at θ brings back the environment reflected by its
-    /// smooth surface, F_r(η, cos θ) (Fresnel's equations), plus the exitance of the nearest
-    /// sample times the exit weight W_o = F_t(η, cos θ)/(cπ) (Fresnel's weights); a ray that
-    /// goes up meets nothing and brings back nothing.
+    /// smooth surface, F_r(η, cos θ) (Fresnel's equations), plus the exitance of the sample
+    /// nearest the hit (found here by brute force; each sample has its own) times the exit
+    /// weight W_o = F_t(η, cos θ)/(cπ) (Fresnel's weights); a ray that goes up meets nothing
+    /// and brings back nothing.
     #[test]
     fn a_ray_brings_back_the_mirrored_environment_and_the_weighted_exitance() {
         let scene = slab();
@@ -370,8 +371,12 @@ mod tests {
         };
         let samples = frame.irradiance_samples(&settings);
         let emitters = Emitters::new(&scene.lights);
-        let m = [0.5, 1.0, 2.0];
-        let exitance: Vec<Vec<Rgb>> = samples.iter().map(|s| vec![m; s.samples.len()]).collect();
+        // Each sample its own exitance, so that reading another sample's shows.
+        let m_of = |q: DVec3| [0.5 + 0.01 * q.x.abs(), 1.0 + 0.01 * q.y.abs(), 2.0];
+        let exitance: Vec<Vec<Rgb>> = samples
+            .iter()
+            .map(|s| s.samples.iter().map(|q| m_of(q.position)).collect())
+            .collect();
         let nearest: Vec<Option<Nearest>> = vec![Some(Nearest::new(&samples[0]))];
         let by_object = vec![Some(0)];
         let sh = frame.shading_of(0).unwrap();
@@ -396,6 +401,15 @@ mod tests {
             let l = along(dir);
             let c = t.cos();
             let w = ft_dielectric(c, sh.eta) * sh.norm;
+            // The hit on the top face (z = 0) and the sample nearest it, by brute force.
+            let hit = p + dir * (p.z / -dir.z);
+            let m = samples[0]
+                .samples
+                .iter()
+                .map(|q| q.position)
+                .min_by(|a, b| (*a - hit).length().total_cmp(&(*b - hit).length()))
+                .map(m_of)
+                .unwrap();
             for ch in 0..3 {
                 let want = fr_dielectric(c, sh.eta) + w * m[ch];
                 assert!(
