@@ -84,18 +84,21 @@ pub(crate) fn bounced(
         }
     }
     let emitters = Emitters::new(&frame.scene.lights);
+    // The samples' positions do not change from bounce to bounce: their lookups are built once,
+    // over the direct set.
+    let nearest: Vec<Option<Nearest>> = (0..frame.scene.objects.len() as u32)
+        .map(|o| direct.iter().find(|s| s.object == o).map(Nearest::new))
+        .collect();
+    let by_object: Vec<Option<usize>> = (0..frame.scene.objects.len() as u32)
+        .map(|o| direct.iter().position(|s| s.object == o))
+        .collect();
+    let weight = PI / f64::from(BOUNCE_RAYS);
     let mut lit: Vec<ObjectSamples> = direct.to_vec();
     let (rays, unsampled) = (AtomicU64::new(0), AtomicU64::new(0));
     for bounce in 0..bounces {
         let exitance = frame.timed("bounce_exitance", || {
             exitance_at_samples(frame, &lit, balls)
         });
-        let nearest: Vec<Option<Nearest>> = (0..frame.scene.objects.len() as u32)
-            .map(|o| lit.iter().find(|s| s.object == o).map(Nearest::new))
-            .collect();
-        let by_object: Vec<Option<usize>> = (0..frame.scene.objects.len() as u32)
-            .map(|o| lit.iter().position(|s| s.object == o))
-            .collect();
         let gathered: Vec<Vec<Rgb>> = lit
             .iter()
             .map(|s| {
@@ -115,10 +118,9 @@ pub(crate) fn bounced(
                                 frame, &emitters, &exitance, &nearest, &by_object, p.position,
                                 p.normal, dir, &unsampled,
                             );
-                            let w = PI / f64::from(BOUNCE_RAYS);
                             packets.push(Incident {
                                 dir,
-                                e_cos: l.map(|v| v * w),
+                                e_cos: l.map(|v| v * weight),
                             });
                         }
                         rays.fetch_add(u64::from(BOUNCE_RAYS), Ordering::Relaxed);
@@ -279,6 +281,13 @@ fn cosine_about(n: DVec3, u1: f64, u2: f64) -> DVec3 {
     (a * (s * phi.cos()) + b * (s * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize_or(n)
 }
 
+/// The grid cell of side `cell` holding `p`, if `p` is finite.
+fn cell_of(p: DVec3, cell: f64) -> Option<[i64; 3]> {
+    let q = (p / cell).floor();
+    q.is_finite()
+        .then_some([q.x as i64, q.y as i64, q.z as i64])
+}
+
 /// The samples of one object in a grid of cells twice their spacing, for the nearest sample
 /// to a surface point.
 struct Nearest<'a> {
@@ -291,29 +300,21 @@ impl<'a> Nearest<'a> {
     fn new(samples: &'a ObjectSamples) -> Self {
         let cell = 2.0 * samples.spacing.max(f64::MIN_POSITIVE);
         let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        let mut out = Nearest {
-            samples,
-            cell,
-            grid: HashMap::new(),
-        };
         for (i, s) in samples.samples.iter().enumerate() {
-            if let Some(c) = out.cell_of(s.position) {
+            if let Some(c) = cell_of(s.position, cell) {
                 grid.entry(c).or_default().push(i as u32);
             }
         }
-        out.grid = grid;
-        out
-    }
-
-    fn cell_of(&self, p: DVec3) -> Option<[i64; 3]> {
-        let q = (p / self.cell).floor();
-        q.is_finite()
-            .then_some([q.x as i64, q.y as i64, q.z as i64])
+        Nearest {
+            samples,
+            cell,
+            grid,
+        }
     }
 
     /// The sample nearest `p` within one cell (twice the spacing), if any.
     fn find(&self, p: DVec3) -> Option<usize> {
-        let c = self.cell_of(p)?;
+        let c = cell_of(p, self.cell)?;
         let mut best: Option<(f64, usize)> = None;
         for dx in -1..=1 {
             for dy in -1..=1 {
