@@ -263,6 +263,9 @@ fn compute_within(
             // The directional dipole and a drifting model need each packet's direction.
             let directional = mat.model == ModelKind::DirectionalDipole || mat.drift;
             let weights = BoundaryWeights::of(mat);
+            // `unscattered = true`: only the share of each packet that scatters enters the
+            // profile.
+            let collision = crate::unscattered::Collision::of(mat);
             let lit: Vec<(IrradianceSample, Vec<Incident>)> = points
                 .par_iter()
                 .enumerate()
@@ -297,6 +300,9 @@ fn compute_within(
                         .texture
                         .as_ref()
                         .map_or([1.0; 3], |t| t.eval(s.position));
+                    if let Some(c) = &collision {
+                        c.scale_entering(geom, o, (s.position, n, ng), &mut inc);
+                    }
                     let e = weights.entering(&mut inc, n, tex);
                     let sample = IrradianceSample {
                         position: s.position,

@@ -97,6 +97,7 @@ pub mod progress;
 pub mod rng;
 pub mod sampling_rate;
 pub mod shading;
+pub mod unscattered;
 pub mod volume;
 
 pub use error::Error;

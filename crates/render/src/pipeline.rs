@@ -128,7 +128,7 @@ pub fn render(
     }
     let frame = Frame::prepare(scene, settings.seed);
     progress.start(frame.gbuffer.samples.len() as u64);
-    let shaded = integrator.integrate(&frame, progress)?;
+    let mut shaded = integrator.integrate(&frame, progress)?;
     if shaded.values.len() != frame.gbuffer.samples.len() {
         return Err(crate::Error::Input(format!(
             "internal: method {} returned {} values for {} G-buffer samples",
@@ -136,6 +136,29 @@ pub fn render(
             shaded.values.len(),
             frame.gbuffer.samples.len()
         )));
+    }
+    // The light refracted through the objects without a collision, and the share of the
+    // model's light that scattered along each camera ray (`unscattered = true`).
+    if !integrator.follows_media() && crate::unscattered::wanted(scene) {
+        let split = frame.timed("unscattered", || crate::unscattered::split(&frame));
+        for ((v, u), k) in shaded
+            .values
+            .iter_mut()
+            .zip(&split.light)
+            .zip(&split.leaving)
+        {
+            for c in 0..3 {
+                v[c] = v[c] * k[c] + u[c];
+            }
+        }
+        shaded.stats.push(Stat {
+            name: "unscattered_rays",
+            value: split.counts.rays as f64,
+        });
+        shaded.stats.push(Stat {
+            name: "unscattered_parts_cut",
+            value: split.counts.cut as f64,
+        });
     }
     let (irradiance_samples, spacing) = frame.samples_built();
     let irradiance_left_out = frame.samples_left_out();

@@ -314,6 +314,9 @@ impl Sampler<'_> {
         if packets.is_empty() {
             return [0.0; 3];
         }
+        if let Some(c) = &shading.collision {
+            c.scale_entering(geom, pi.object, (pi.p, pi.n, pi.ng), packets);
+        }
         let tex = shading.texture_at(pi.p);
         let mut out = [0.0; 3];
         if shading.directional() {

@@ -167,6 +167,9 @@ pub struct TranslucentShading {
     /// number or `"auto"`, [`SphereProfile`]): its profile is tabulated and ends at the ball's
     /// diameter.
     pub ball_mm: Option<f64>,
+    /// `unscattered = true`: the split of the light between what goes straight through and
+    /// what scatters ([`crate::unscattered::Collision`]), or `None`.
+    pub collision: Option<crate::unscattered::Collision>,
     /// The disk-average quadrature of [`rd_sample_scene`](Self::rd_sample_scene).
     disk: DiskRule,
 }
@@ -235,6 +238,7 @@ impl TranslucentShading {
                 .sphere_radius
                 .filter(|_| !local && t.model != ModelKind::DirectionalDipole)
                 .map(|r| r / t.units_per_mm),
+            collision: crate::unscattered::Collision::of(t),
             disk,
         }
     }
@@ -953,6 +957,7 @@ mod tests {
                 sphere_radius: None,
                 local_radius: false,
                 drift: false,
+                unscattered: false,
             },
         )
     }
@@ -994,6 +999,7 @@ mod tests {
             sphere_radius: None,
             local_radius: false,
             drift: true,
+            unscattered: false,
         };
         let drifting = TranslucentShading::new("test", &t);
         assert!(drifting.drift.is_some() && plain.drift.is_none());

@@ -74,6 +74,7 @@ pub(super) struct MaterialDef {
     pub angular: Option<String>,
     pub sphere_radius: Option<RadiusDef>,
     pub drift: Option<bool>,
+    pub unscattered: Option<bool>,
 }
 
 /// `sphere_radius = 12.5` (scene units), `sphere_radius = "auto"` or `sphere_radius = "local"`.
@@ -170,6 +171,7 @@ impl Keys for MaterialDef {
             ("angular", self.angular.is_some()),
             ("sphere_radius", self.sphere_radius.is_some()),
             ("drift", self.drift.is_some()),
+            ("unscattered", self.unscattered.is_some()),
         ])
     }
 }

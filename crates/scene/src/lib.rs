@@ -201,6 +201,11 @@ pub struct Translucent {
     /// walk says (`sss_bssrdf::EntryDrift`: S times 1 + k(r, θ_i) cos φ), instead of evenly
     /// around it (false, the default).
     pub drift: bool,
+    /// Whether the light refracted through the object without a collision is added to the
+    /// model's (`unscattered = true`): Beer–Lambert attenuation along the refracted rays
+    /// through the real geometry, which no BSSRDF profile carries, most of the light of
+    /// strongly absorbing or optically thin media seen against bright light. False by default.
+    pub unscattered: bool,
 }
 
 /// The angular factors of a radial model, S = W_i(θ_i) R_d(r) W_o(θ_o).

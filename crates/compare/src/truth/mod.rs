@@ -8,8 +8,9 @@
 //!   discretises, its own noise removed: the model's floor against the truth);
 //! - the fast methods (`dual-tree-fmm`, `manylight`, `separable`) over their sweeps, with
 //!   `mc-table`, and `dual-tree-fmm` with each point's own ball too
-//!   (`mc-table+albedo+local`), and with one bounce of the light the surfaces trade
-//!   (`mc-table+albedo+local+bounce`);
+//!   (`mc-table+albedo+local`), and with one bounce of the light the surfaces trade and the
+//!   light refracted through the objects without a collision
+//!   (`mc-table+albedo+local+bounce+unscattered`);
 //! - `volpath` at increasing paths per pixel, with another seed, on the same axes, so the
 //!   report reads off for each method and model the time at which brute force reaches the same
 //!   error ([`Crossover`]).
@@ -48,6 +49,7 @@ use images::{SIGNED_RANGE, write_pictures, write_plot};
 use peers::{Peers, run_peers};
 use plan::{
     Case, Plan, plan, with_albedo_weights, with_ball_profile, with_drift, with_local_balls,
+    with_unscattered,
 };
 use report::{CaseResult, section, truth_csv};
 use runs::{

@@ -158,6 +158,16 @@ pub(crate) fn with_local_balls(scene: &mut Scene) {
     }
 }
 
+/// Adds to every translucent material of `scene` the light refracted through its objects
+/// without a collision (`unscattered = true`).
+pub(crate) fn with_unscattered(scene: &mut Scene) {
+    for m in &mut scene.materials {
+        if let MaterialKind::Translucent(t) = &mut m.kind {
+            t.unscattered = true;
+        }
+    }
+}
+
 /// Gives every translucent material of `scene` the walk's drift of obliquely entering light
 /// (`drift = true`).
 pub(crate) fn with_drift(scene: &mut Scene) {

@@ -94,8 +94,9 @@ pub(crate) fn section(
          relative noise is small; every model under `exact` (its sum) and `pathtrace` (the \
          integral it discretises), the fast methods with `mc-table` over their sweeps \
          (`dual-tree-fmm` with `mc-table+albedo+local` too: each point's own ball; and \
-         `mc-table+albedo+local+bounce`, the same with one bounce of the light the surfaces \
-         trade, `--bounces 1`), and \
+         `mc-table+albedo+local+bounce+unscattered`, the same with one bounce of the light \
+         the surfaces trade, `--bounces 1`, and the light refracted through the objects \
+         without a collision, `unscattered = true`), and \
          `volpath` at fewer paths, all scored \
          over the pixels inside the silhouette (a pixel and its eight neighbours covered) with \
          the reference's noise removed. *volpath to the same \

@@ -34,10 +34,11 @@ pub const BALL_MODEL: &str = "mc-table+albedo+ball";
 /// entry point, as the random walk says) in the runs' `model` column.
 pub const DRIFT_MODEL: &str = "mc-table+albedo+ball+drift";
 
-/// The name of [`ALBEDO_MODEL`] with each point's own ball (`sphere_radius = "local"`) and the
-/// drift in each pair's ball (`drift = true`) in the runs' `model` column. Only `exact` renders
-/// it.
-pub const LOCAL_MODEL: &str = "mc-table+albedo+local+drift";
+/// The name of [`ALBEDO_MODEL`] with each point's own ball (`sphere_radius = "local"`), the
+/// drift in each pair's ball (`drift = true`) and the light refracted through the object
+/// without a collision (`unscattered = true`) in the runs' `model` column. Only `exact`
+/// renders it.
+pub const LOCAL_MODEL: &str = "mc-table+albedo+local+drift+unscattered";
 
 /// The name of [`ALBEDO_MODEL`] with each point's own ball (`sphere_radius = "local"`) and no
 /// drift in the runs' `model` column: the model [`LOCAL_FAST`] sweep too.
@@ -48,8 +49,9 @@ pub const LOCAL_FAST_MODEL: &str = "mc-table+albedo+local";
 pub const LOCAL_FAST: [&str; 1] = ["dual-tree-fmm"];
 
 /// The name of [`LOCAL_FAST_MODEL`] rendered with one bounce of the light the surfaces trade
-/// (`--bounces 1`) in the runs' `model` column, swept by [`LOCAL_FAST`] too.
-pub const BOUNCE_FAST_MODEL: &str = "mc-table+albedo+local+bounce";
+/// (`--bounces 1`) and the light refracted through the object without a collision
+/// (`unscattered = true`) in the runs' `model` column, swept by [`LOCAL_FAST`] too.
+pub const BOUNCE_FAST_MODEL: &str = "mc-table+albedo+local+bounce+unscattered";
 
 /// The `--bounces` of [`BOUNCE_FAST_MODEL`].
 pub const FAST_BOUNCES: u32 = 1;
@@ -171,6 +173,7 @@ pub(crate) fn run_case(
                 }
                 if name == LOCAL_MODEL {
                     with_local_balls(&mut scene);
+                    with_unscattered(&mut scene);
                 }
                 if name == DRIFT_MODEL || name == LOCAL_MODEL {
                     with_drift(&mut scene);
@@ -230,6 +233,8 @@ pub(crate) fn run_case(
         let mut local = scene_for(FAST_MODEL)?;
         with_albedo_weights(&mut local);
         with_local_balls(&mut local);
+        let mut full = local.clone();
+        with_unscattered(&mut full);
         let jobs = FAST
             .iter()
             .map(|&name| (name, &plain, FAST_MODEL.name(), 0))
@@ -241,7 +246,7 @@ pub(crate) fn run_case(
             .chain(
                 LOCAL_FAST
                     .iter()
-                    .map(|&name| (name, &local, BOUNCE_FAST_MODEL, FAST_BOUNCES)),
+                    .map(|&name| (name, &full, BOUNCE_FAST_MODEL, FAST_BOUNCES)),
             );
         for (name, scene, model, bounces) in jobs {
             let m = integrators::method(name).map_err(|e| Error(e.to_string()))?;

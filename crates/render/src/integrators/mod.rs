@@ -116,6 +116,13 @@ pub trait Integrator: Send + Sync {
         let _ = (scene, samples);
         0
     }
+    /// Whether the method follows light through the media themselves (`volpath`), so that its
+    /// image already holds the light refracted through the objects without a collision: the
+    /// pipeline adds that light ([`crate::unscattered`], the scene key `unscattered`) to every
+    /// other method's image.
+    fn follows_media(&self) -> bool {
+        false
+    }
     /// Shades every G-buffer sample on a visible translucent object of `frame`.
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error>;
 }

@@ -191,6 +191,9 @@ impl Integrator for Separable {
                         &mut r,
                         packets,
                     );
+                    if let Some(c) = &sh.collision {
+                        c.scale_entering(&frame.geom, g.object, (g.p, g.n, g.ng), packets);
+                    }
                     sh.weights.entering(packets, g.n, sh.texture_at(g.p))
                 })
                 .collect()

@@ -23,9 +23,10 @@
 //!   the refracted ray never samples; Mitsuba 3's image is black there too): such a scene is
 //!   refused with an error naming `--boundary lambertian`, which reaches them by next-event
 //!   estimation, never rendered silently black.
-//! - Scattering orders: `--scattering single` or `multiple` keeps only the light whose path
-//!   collided once, or two times or more, in the media ([`Scattering`]), so the share of each
-//!   order in real transport can be measured (`cargo xtask compare --deficit`).
+//! - Scattering orders: `--scattering single`, `multiple` or `unscattered` keeps only the
+//!   light whose path collided once, two times or more, or never in the media
+//!   ([`Scattering`]), so the share of each order in real transport can be measured (`cargo
+//!   xtask compare --deficit`).
 //! - Light traded between translucent surfaces: `--reentry no` ends a path where, having left
 //!   a medium, it meets a translucent surface, so the image holds only the light a BSSRDF
 //!   under direct light can carry; the difference from `yes` is the interreflection between
@@ -99,10 +100,10 @@ pub const OPTIONS: [OptionSpec; 6] = [
         value_name: "ORDERS",
         default: "all",
         help: "Which light the image holds, by the collisions of its path in the media: `all`, \
-               `single` (exactly one collision) or `multiple` (two or more); light that \
-               crossed a medium without a collision is only in `all`",
+               `single` (exactly one collision), `multiple` (two or more) or `unscattered` \
+               (none: light refracted through the media and out again)",
         kind: OptionKind::Value,
-        values: &["all", "single", "multiple"],
+        values: &["all", "single", "multiple", "unscattered"],
     },
     OptionSpec {
         name: "reentry",
@@ -219,9 +220,10 @@ impl VolPath {
             "all" => Scattering::All,
             "single" => Scattering::Single,
             "multiple" => Scattering::Multiple,
+            "unscattered" => Scattering::Unscattered,
             other => {
                 return Err(Error::Input(format!(
-                    "--scattering: `{other}` is not one of all, single, multiple"
+                    "--scattering: `{other}` is not one of all, single, multiple, unscattered"
                 )));
             }
         };
@@ -285,6 +287,10 @@ impl Integrator for VolPath {
             self.scattering.name(),
             if self.reentry { "yes" } else { "no" }
         )
+    }
+
+    fn follows_media(&self) -> bool {
+        true
     }
 
     fn integrate(&self, frame: &Frame<'_>, progress: &dyn Progress) -> Result<Shaded, Error> {

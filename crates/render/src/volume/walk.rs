@@ -79,6 +79,9 @@ pub enum Scattering {
     Single,
     /// Paths with two collisions or more.
     Multiple,
+    /// Paths with no collision: light refracted through the media and out again, attenuated
+    /// but never scattered (a path ends at its first collision).
+    Unscattered,
 }
 
 impl Scattering {
@@ -88,6 +91,7 @@ impl Scattering {
             Scattering::All => "all",
             Scattering::Single => "single",
             Scattering::Multiple => "multiple",
+            Scattering::Unscattered => "unscattered",
         }
     }
 
@@ -97,6 +101,7 @@ impl Scattering {
             Scattering::All => true,
             Scattering::Single => collisions == 1,
             Scattering::Multiple => collisions >= 2,
+            Scattering::Unscattered => collisions == 0,
         }
     }
 }
@@ -252,8 +257,11 @@ impl Walker<'_> {
                             events += 1;
                             counts.collisions += 1;
                             collisions += 1;
-                            // Single scattering needs nothing past the first collision.
-                            if self.scattering == Scattering::Single && collisions > 1 {
+                            // Single scattering needs nothing past the first collision, the
+                            // unscattered light nothing past none.
+                            if (self.scattering == Scattering::Single && collisions > 1)
+                                || self.scattering == Scattering::Unscattered
+                            {
                                 return acc;
                             }
                             w.scatter(med.sigma_s, med.sigma_t, t);

@@ -195,6 +195,7 @@ fn slab(units_per_mm: f64) -> ([f64; 3], [f64; 3]) {
             sphere_radius: None,
             local_radius: false,
             drift: false,
+            unscattered: false,
         }),
     };
     let e0 = [2.0, 1.0, 0.5];

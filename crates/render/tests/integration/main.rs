@@ -28,6 +28,7 @@ mod sparse_manylight;
 mod sphere_profile;
 mod subset_reference;
 mod trees;
+mod unscattered;
 mod volpath;
 mod volpath_mcml;
 mod volpath_mitsuba;

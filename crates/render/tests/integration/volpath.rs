@@ -26,6 +26,7 @@ fn white(sigma_s: [f64; 3]) -> Material {
             sphere_radius: None,
             local_radius: false,
             drift: false,
+            unscattered: false,
         }),
     }
 }

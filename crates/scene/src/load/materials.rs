@@ -30,6 +30,7 @@ impl Ctx<'_> {
                         "angular",
                         "sphere_radius",
                         "drift",
+                        "unscattered",
                     ],
                     what,
                 )?;
@@ -210,6 +211,7 @@ impl Ctx<'_> {
                     sphere_radius,
                     local_radius,
                     drift,
+                    unscattered: m.unscattered.unwrap_or(false),
                 }))
             }
             "diffuse" => {

@@ -893,3 +893,33 @@ fn object_errors() {
         &["needs `file`"],
     );
 }
+
+/// `unscattered`: off by default, `true` or `false` on every model (the directional dipole
+/// too: the light refracted straight through is no model's), and nothing but a boolean.
+#[test]
+fn unscattered() {
+    let flag = |s: &sss_scene::Scene, i: usize| match &s.materials[i].kind {
+        MaterialKind::Translucent(t) => t.unscattered,
+        _ => panic!("material {i} is translucent"),
+    };
+    let s = load_str(GOOD, "good.toml", None, &no_dirs()).unwrap();
+    assert!(!flag(&s, 0) && !flag(&s, 1));
+    for (v, want) in [("true", true), ("false", false)] {
+        let text = with("eta = 1.4", &format!("eta = 1.4\nunscattered = {v}"));
+        let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+        assert_eq!(flag(&s, 1), want, "unscattered = {v}");
+        assert!(!flag(&s, 0), "only the material that names it");
+    }
+    let text = with(
+        "model = \"directional-dipole\"",
+        "model = \"directional-dipole\"\nunscattered = true",
+    );
+    let s = load_str(&text, "good.toml", None, &no_dirs()).unwrap();
+    assert!(flag(&s, 0));
+    assert_err(
+        &with("eta = 1.4", "eta = 1.4\nunscattered = 1"),
+        Some("unscattered = 1"),
+        Some("materials.jelly.unscattered"),
+        &["expected a boolean"],
+    );
+}

@@ -119,6 +119,15 @@ pub(crate) fn object_data(
         };
         sh.radial(method)?;
         sh.scalar_weights(method)?;
+        if sh.collision.is_some() {
+            return Err(Error::Unsupported(format!(
+                "material `{}`: method {method} does not take `unscattered = true` (its \
+                 estimator lights its points without the ray through the object that splits \
+                 off the light going straight through); use exact, the trees, pathtrace or \
+                 separable",
+                sh.name
+            )));
+        }
         if sh.texture.is_some() {
             return Err(Error::Input(format!(
                 "material `{}`: method {method} does not support pre-scatter textures (the \

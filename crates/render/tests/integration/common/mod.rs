@@ -138,6 +138,7 @@ pub fn translucent(model: ModelKind, preset: &str, units_per_mm: f64) -> Materia
             sphere_radius: None,
             local_radius: false,
             drift: false,
+            unscattered: false,
         }),
     }
 }
