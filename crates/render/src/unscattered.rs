@@ -96,8 +96,8 @@ enum Place {
     Outside,
 }
 
-/// One part of the chain: a ray leaving surface point `p` (geometric normal `ng`) along `dir`
-/// with per-channel weight `w`, after `events` crossings.
+/// One part of the chain: a ray leaving surface point `p` along `dir` with per-channel weight
+/// `w`, after `events` crossings.
 #[derive(Clone, Copy)]
 struct Part {
     place: Place,
