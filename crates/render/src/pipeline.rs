@@ -138,7 +138,9 @@ pub fn render(
         )));
     }
     // The light refracted through the objects without a collision, and the share of the
-    // model's light that scattered along each camera ray (`unscattered = true`).
+    // model's light that scattered along each camera ray (`unscattered = true`). A method's
+    // standard errors are left as they are: the share is at most 1, so they stay an upper
+    // bound.
     if !integrator.follows_media() && crate::unscattered::wanted(scene) {
         let split = frame.timed("unscattered", || crate::unscattered::split(&frame));
         for ((v, u), k) in shaded

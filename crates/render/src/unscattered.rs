@@ -392,18 +392,27 @@ impl Collision {
         })
     }
 
-    /// The ratio of the share colliding along the refracted direction `inward` to the share
-    /// along the inward normal, per channel, at most 1 (see the type; 1 where the normal's
-    /// share is 0).
+    /// The share colliding along the inward normal at `p`: what the profile's walk assumes.
+    fn along_normal(
+        &self,
+        geom: &SceneGeometry,
+        object: u32,
+        (p, n, ng): (DVec3, DVec3, DVec3),
+    ) -> Rgb {
+        self.collides(chord(geom, object, p, ng, -n))
+    }
+
+    /// The ratio of the share colliding along the refracted direction `inward` to `normal`,
+    /// the share along the inward normal, per channel, at most 1 (see the type; 1 where the
+    /// normal's share is 0).
     fn ratio(
         &self,
         geom: &SceneGeometry,
         object: u32,
-        at: (DVec3, DVec3, DVec3),
+        (p, ng): (DVec3, DVec3),
+        normal: Rgb,
         inward: DVec3,
     ) -> Rgb {
-        let (p, n, ng) = at;
-        let normal = self.collides(chord(geom, object, p, ng, -n));
         let here = self.collides(chord(geom, object, p, ng, inward));
         [0, 1, 2].map(|c| {
             if normal[c] > 0.0 {
@@ -425,10 +434,11 @@ impl Collision {
         (p, n, ng): (DVec3, DVec3, DVec3),
         packets: &mut [Incident],
     ) {
+        let normal = self.along_normal(geom, object, (p, n, ng));
         for packet in packets.iter_mut() {
             let (_, t) = fresnel(-packet.dir, n, self.eta);
             let Some(t) = t else { continue };
-            let r = self.ratio(geom, object, (p, n, ng), t);
+            let r = self.ratio(geom, object, (p, ng), normal, t);
             for c in 0..3 {
                 packet.e_cos[c] *= r[c];
             }
@@ -440,7 +450,10 @@ impl Collision {
     pub fn leaving(&self, geom: &SceneGeometry, g: &GSample) -> Rgb {
         let (_, t) = fresnel(-g.wo, g.n, self.eta);
         match t {
-            Some(t) => self.ratio(geom, g.object, (g.p, g.n, g.ng), t),
+            Some(t) => {
+                let normal = self.along_normal(geom, g.object, (g.p, g.n, g.ng));
+                self.ratio(geom, g.object, (g.p, g.ng), normal, t)
+            }
             None => [1.0; 3],
         }
     }
