@@ -55,6 +55,7 @@ use crate::lights::Incident;
 use crate::volume::boundary::{fresnel, reflect};
 use crate::volume::emitters::Emitters;
 use crate::volume::interior::Interior;
+use crate::volume::walk::surface_tolerance;
 use glam::DVec3;
 use rayon::prelude::*;
 use sss_bssrdf::Rgb;
@@ -82,8 +83,6 @@ struct Chain<'a> {
     geom: &'a SceneGeometry,
     /// Per material: its interior (None for opaque materials).
     interiors: Vec<Option<Interior>>,
-    /// Per material: whether its points start a chain.
-    starts: Vec<bool>,
     /// Per object: its material.
     material_of: Vec<usize>,
     emitters: Emitters,
@@ -130,26 +129,13 @@ impl Chain<'_> {
         self.interiors[self.material_of[object as usize]].as_ref()
     }
 
-    /// The unscattered radiance leaving `g` towards the camera through its object's boundary
-    /// (0 unless its material asks for it).
-    fn radiance(&self, g: &GSample, counts: &mut ChainCounts) -> Rgb {
-        let m = self.material_of[g.object as usize];
+    /// The unscattered radiance leaving `g` towards the camera through its object's boundary,
+    /// of relative index of refraction `eta`.
+    fn radiance(&self, g: &GSample, eta: f64, counts: &mut ChainCounts) -> Rgb {
         let mut acc = [0.0; 3];
-        if !self.starts[m] {
-            return acc;
-        }
-        let Some(interior) = self.interiors[m].as_ref() else {
-            return acc;
-        };
-        let (f, t) = fresnel(-g.wo, g.n, interior.eta);
+        let (f, t) = fresnel(-g.wo, g.n, eta);
         let Some(dir) = t else { return acc };
-        // A refracted direction on the outside of the geometric surface (shading normals at
-        // grazing angles) is mirrored through it, as `volpath`'s camera vertex does.
-        let dir = if dir.dot(g.ng) >= 0.0 {
-            reflect(dir, g.ng)
-        } else {
-            dir
-        };
+        let dir = inward(dir, g.ng);
         let mut parts = vec![Part {
             place: Place::Inside(g.object),
             p: g.p,
@@ -176,7 +162,7 @@ impl Chain<'_> {
     /// Traces one part to its next surface: collects what it sees outside, and pushes the
     /// parts it splits into.
     fn follow(&self, part: Part, parts: &mut Vec<Part>, acc: &mut Rgb) {
-        let t_min = tolerance(self.geom, part.p);
+        let t_min = surface_tolerance(self.geom, part.p);
         let next = |place, p, dir, w| Part {
             place,
             p,
@@ -273,27 +259,20 @@ pub struct Split {
 /// light.
 pub fn split(frame: &Frame<'_>) -> Split {
     let scene = frame.scene;
-    let mut interiors = Vec::with_capacity(scene.materials.len());
-    let mut starts = Vec::with_capacity(scene.materials.len());
-    for m in &scene.materials {
-        match &m.kind {
-            MaterialKind::Translucent(t) => {
-                starts.push(t.unscattered);
-                // Every medium that loads has a positive, finite extinction per scene unit
-                // (`sss_bssrdf::Medium::new` refuses the others); one that did not would end
-                // the chain like an opaque surface.
-                interiors.push(Interior::new(&m.name, t, None).ok());
-            }
-            MaterialKind::Diffuse { .. } => {
-                starts.push(false);
-                interiors.push(None);
-            }
-        }
-    }
+    // Every medium that loads has a positive, finite extinction per scene unit
+    // (`sss_bssrdf::Medium::new` refuses the others); one that did not would end the chain
+    // like an opaque surface.
+    let interiors = scene
+        .materials
+        .iter()
+        .map(|m| match &m.kind {
+            MaterialKind::Translucent(t) => Interior::new(&m.name, t, None).ok(),
+            MaterialKind::Diffuse { .. } => None,
+        })
+        .collect();
     let chain = Chain {
         geom: &frame.geom,
         interiors,
-        starts,
         material_of: scene.objects.iter().map(|o| o.material).collect(),
         emitters: Emitters::new(&scene.lights),
     };
@@ -304,12 +283,17 @@ pub fn split(frame: &Frame<'_>) -> Split {
         .with_min_len(256)
         .map(|g| {
             let mut counts = ChainCounts::default();
-            let light = chain.radiance(g, &mut counts);
-            let leaving = frame
+            // A chain starts where the material asks for the split.
+            match frame
                 .shading_of(g.object)
                 .and_then(|sh| sh.collision.as_ref())
-                .map_or([1.0; 3], |c| c.leaving(&frame.geom, g));
-            (light, leaving, counts)
+            {
+                Some(c) => {
+                    let light = chain.radiance(g, c.eta, &mut counts);
+                    (light, c.leaving(&frame.geom, g), counts)
+                }
+                None => ([0.0; 3], [1.0; 3], counts),
+            }
         })
         .collect();
     let mut out = Split::default();
@@ -321,24 +305,24 @@ pub fn split(frame: &Frame<'_>) -> Split {
     out
 }
 
+/// `dir`, a direction refracted into a surface of geometric normal `ng`, mirrored through the
+/// geometric surface when it points out of it (shading normals at grazing angles), as
+/// `volpath`'s camera vertex does.
+fn inward(dir: DVec3, ng: DVec3) -> DVec3 {
+    if dir.dot(ng) >= 0.0 {
+        reflect(dir, ng)
+    } else {
+        dir
+    }
+}
+
 /// The chord of object `object` from its surface point `p` (geometric normal `ng`) along the
 /// inward unit `dir` (mirrored through the geometric surface when it points out of it): the
 /// distance to the object's next surface, ∞ when there is none (an open mesh).
 fn chord(geom: &SceneGeometry, object: u32, p: DVec3, ng: DVec3, dir: DVec3) -> f64 {
-    let dir = if dir.dot(ng) >= 0.0 {
-        reflect(dir, ng)
-    } else {
-        dir
-    };
-    geom.closest_hit_on(object, p, dir, tolerance(geom, p), f64::INFINITY)
+    let dir = inward(dir, ng);
+    geom.closest_hit_on(object, p, dir, surface_tolerance(geom, p), f64::INFINITY)
         .map_or(f64::INFINITY, |h| h.t)
-}
-
-/// Hits closer than this to the surface point `p` a ray leaves from are that surface (the
-/// tolerance of `volpath`'s walk: 10⁻⁹ of the point's largest coordinate plus 10⁻¹² of the
-/// scene's extent).
-fn tolerance(geom: &SceneGeometry, p: DVec3) -> f64 {
-    1e-9 * p.abs().max_element() + 1e-12 * geom.extent()
 }
 
 /// The split of a material's light between what goes straight through (the term of

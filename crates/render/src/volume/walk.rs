@@ -127,6 +127,12 @@ pub struct Walker<'a> {
     pub reentry: bool,
 }
 
+/// Hits closer than this to a surface point `p` a ray leaves from are the surface itself:
+/// 10⁻⁹ of the point's largest coordinate plus 10⁻¹² of the scene's extent.
+pub fn surface_tolerance(geom: &SceneGeometry, p: DVec3) -> f64 {
+    1e-9 * p.abs().max_element() + 1e-12 * geom.extent()
+}
+
 /// Where the path is.
 enum Place {
     /// Inside object `o`'s medium.
@@ -136,10 +142,8 @@ enum Place {
 }
 
 impl Walker<'_> {
-    /// Hits closer than this to a surface point `p` the ray leaves from are the surface itself:
-    /// 10⁻⁹ of the point's largest coordinate plus 10⁻¹² of the scene's extent.
     fn tolerance(&self, p: DVec3) -> f64 {
-        1e-9 * p.abs().max_element() + 1e-12 * self.geom.extent()
+        surface_tolerance(self.geom, p)
     }
 
     fn interior_of(&self, object: u32) -> Option<&Interior> {
